@@ -1,0 +1,168 @@
+//! Diagnostics as plain data. The terminal (ariadne), JSON and LSP renderings
+//! are all made from this one value.
+
+use crate::source::Span;
+use serde::Serialize;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Severity {
+    Error,
+    Warning,
+}
+
+/// A stable diagnostic code with a one-line title for the reference table.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Code {
+    pub id: &'static str,
+    pub title: &'static str,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Label {
+    pub span: Span,
+    pub message: String,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Diagnostic {
+    pub code: &'static str,
+    pub severity: Severity,
+    pub message: String,
+    pub span: Span,
+    /// Secondary places, e.g. the earlier definition of a duplicate.
+    pub labels: Vec<Label>,
+    pub hint: Option<String>,
+}
+
+impl Diagnostic {
+    pub fn error(code: Code, span: Span, message: impl Into<String>) -> Diagnostic {
+        Diagnostic {
+            code: code.id,
+            severity: Severity::Error,
+            message: message.into(),
+            span,
+            labels: Vec::new(),
+            hint: None,
+        }
+    }
+
+    pub fn warning(code: Code, span: Span, message: impl Into<String>) -> Diagnostic {
+        Diagnostic {
+            severity: Severity::Warning,
+            ..Diagnostic::error(code, span, message)
+        }
+    }
+
+    pub fn with_hint(mut self, hint: impl Into<String>) -> Diagnostic {
+        self.hint = Some(hint.into());
+        self
+    }
+
+    pub fn with_label(mut self, span: Span, message: impl Into<String>) -> Diagnostic {
+        self.labels.push(Label {
+            span,
+            message: message.into(),
+        });
+        self
+    }
+
+    pub fn is_error(&self) -> bool {
+        self.severity == Severity::Error
+    }
+}
+
+pub fn has_errors(diags: &[Diagnostic]) -> bool {
+    diags.iter().any(Diagnostic::is_error)
+}
+
+/// "did you mean" support: the closest candidate within a small edit distance.
+pub fn closest<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
+    let limit = (name.chars().count() / 3).max(1);
+    candidates
+        .into_iter()
+        .map(|c| (edit_distance(name, c), c))
+        .filter(|(d, _)| *d <= limit)
+        .min_by_key(|(d, c)| (*d, *c))
+        .map(|(_, c)| c)
+}
+
+pub fn did_you_mean<'a>(
+    name: &str,
+    candidates: impl IntoIterator<Item = &'a str>,
+) -> Option<String> {
+    closest(name, candidates).map(|c| format!("did you mean `{c}`?"))
+}
+
+fn edit_distance(a: &str, b: &str) -> usize {
+    let a: Vec<char> = a.chars().flat_map(char::to_lowercase).collect();
+    let b: Vec<char> = b.chars().flat_map(char::to_lowercase).collect();
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    let mut cur = vec![0; b.len() + 1];
+    for i in 1..=a.len() {
+        cur[0] = i;
+        for j in 1..=b.len() {
+            let cost = usize::from(a[i - 1] != b[j - 1]);
+            cur[j] = (prev[j] + 1).min(cur[j - 1] + 1).min(prev[j - 1] + cost);
+        }
+        std::mem::swap(&mut prev, &mut cur);
+    }
+    prev[b.len()]
+}
+
+/// Every diagnostic code btc emits. The language reference's table is
+/// generated from, and tested against, this list.
+pub mod codes {
+    use super::Code;
+
+    macro_rules! codes {
+        ($($name:ident = $id:literal, $title:literal;)*) => {
+            $(pub const $name: Code = Code { id: $id, title: $title };)*
+            pub const ALL: &[Code] = &[$($name),*];
+        };
+    }
+
+    codes! {
+        // Reading files
+        FILE_UNREADABLE = "F001", "a file cannot be read";
+        FILE_ENCODING = "F002", "a file is not UTF-8 text";
+        FILE_TOO_LARGE = "F003", "a file is larger than btc reads";
+        // PDDL syntax
+        INVALID_TOKEN = "P001", "a character or word that PDDL does not allow";
+        UNCLOSED_PAREN = "P002", "a `(` is never closed";
+        UNEXPECTED_CLOSE = "P003", "a `)` closes nothing";
+        TOO_DEEP = "P004", "parentheses nested deeper than btc supports";
+        EXPECTED = "P005", "the structure of a PDDL file is not what the grammar asks for";
+        UNSUPPORTED = "P006", "a PDDL feature btc does not support";
+        UNKNOWN_REQUIREMENT = "P007", "a requirement flag that PDDL does not define";
+        NOT_A_DEFINE = "P008", "a file is not a PDDL domain or problem";
+        UNKNOWN_SECTION = "P009", "a section keyword that does not belong here";
+        // PDDL semantics
+        UNKNOWN_TYPE = "P101", "a type that the domain does not declare";
+        UNKNOWN_PREDICATE = "P102", "a predicate that the domain does not declare";
+        UNKNOWN_OBJECT = "P103", "a constant or object that is not declared";
+        UNBOUND_VARIABLE = "P104", "a variable that no parameter or quantifier binds";
+        WRONG_ARITY = "P105", "a predicate, function or action used with the wrong number of arguments";
+        TYPE_MISMATCH = "P106", "an argument whose type does not fit the parameter";
+        DUPLICATE = "P107", "something defined twice";
+        UNDECLARED_REQUIREMENT = "P108", "a feature used without its `:requirements` flag";
+        UNKNOWN_FUNCTION = "P109", "a numeric function that the domain does not declare";
+        DOMAIN_MISMATCH = "P110", "a problem names another domain";
+        TYPE_CYCLE = "P111", "a type that is its own ancestor";
+        DERIVED_EFFECT = "P112", "an action effect that changes a derived predicate";
+        NOT_STRATIFIED = "P113", "derived predicates that depend on their own negation";
+        NOT_GROUND = "P114", "a variable where only objects may stand";
+        // Plans
+        PLAN_SYNTAX = "L001", "a plan line in no format btc knows";
+        PLAN_UNKNOWN_ACTION = "L002", "a plan step whose action the domain does not define";
+        PLAN_ARITY = "L003", "a plan step with the wrong number of arguments";
+        PLAN_UNKNOWN_OBJECT = "L004", "a plan step argument that is no object or constant";
+        PLAN_TYPE = "L005", "a plan step argument whose type does not fit the action";
+        PLAN_EMPTY = "L006", "a plan with no steps";
+        // Validation
+        PRECONDITION_FAILS = "V001", "a plan step whose precondition does not hold";
+        GOAL_NOT_REACHED = "V002", "a plan that does not reach the goal";
+        COST_MISMATCH = "V003", "a plan whose stated cost differs from its computed cost";
+        EFFECT_CONFLICT = "V004", "a numeric effect that cannot be computed";
+    }
+}

@@ -1,0 +1,14 @@
+//! The btc compiler library.
+//!
+//! Layering is one-way: text ([`source`]) -> syntax ([`pddl::lexer`],
+//! [`pddl::sexpr`]) -> model ([`pddl::ast`], checked by [`pddl::check`]) ->
+//! plans ([`plan`]) -> simulation ([`validate`]). Nothing here prints or
+//! touches the file system except [`source::load`]; the CLI and the language
+//! server do the IO and render [`diagnostic::Diagnostic`] values.
+
+pub mod diagnostic;
+pub mod pddl;
+pub mod plan;
+pub mod render;
+pub mod source;
+pub mod validate;

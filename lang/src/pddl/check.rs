@@ -1,0 +1,977 @@
+//! Semantic checks of domains and problems, and the symbol tables that every
+//! later stage (plan typing, validation, rule checking) looks names up in.
+
+use super::ast::*;
+use super::types::{TypeId, TypeTable};
+use crate::diagnostic::{codes, did_you_mean, Diagnostic};
+use crate::source::Span;
+use rustc_hash::{FxHashMap, FxHashSet};
+
+/// A declared predicate or function: index into the domain's list and
+/// resolved parameter types.
+#[derive(Clone, Debug)]
+pub struct Signature {
+    pub index: usize,
+    pub params: Vec<Vec<TypeId>>,
+    pub span: Span,
+}
+
+/// An object or constant: its id in [`ProblemIndex::objects`] order (or
+/// in [`DomainIndex::constants`]), its types and where it is declared.
+#[derive(Clone, Debug)]
+pub struct ObjectInfo {
+    pub id: u32,
+    pub types: Vec<TypeId>,
+    pub span: Span,
+}
+
+/// What a checked domain knows by name.
+#[derive(Clone, Debug, Default)]
+pub struct DomainIndex {
+    pub types: TypeTable,
+    pub predicates: FxHashMap<String, Signature>,
+    pub functions: FxHashMap<String, Signature>,
+    pub constants: FxHashMap<String, ObjectInfo>,
+    /// Constant names in declaration order (ids index this).
+    pub constant_names: Vec<String>,
+    pub actions: FxHashMap<String, Signature>,
+    /// Derived predicates, grouped in strata: each stratum only negates
+    /// predicates of earlier strata. Entries index `domain.derived`.
+    pub derived_strata: Vec<Vec<usize>>,
+    pub derived: FxHashSet<String>,
+    /// Requirement flags declared, with implied ones expanded.
+    pub requirements: FxHashSet<String>,
+}
+
+/// What a checked problem knows: every object and constant, with ids.
+#[derive(Clone, Debug, Default)]
+pub struct ProblemIndex {
+    pub objects: FxHashMap<String, ObjectInfo>,
+    /// Names by id: domain constants first, then the problem's objects.
+    pub object_names: Vec<String>,
+    pub object_types: Vec<Vec<TypeId>>,
+}
+
+impl ProblemIndex {
+    /// Every object (constants included) whose type fits `want`.
+    pub fn objects_of(&self, types: &TypeTable, want: &[TypeId]) -> Vec<u32> {
+        (0..self.object_names.len() as u32)
+            .filter(|&i| types.fits(&self.object_types[i as usize], want))
+            .collect()
+    }
+}
+
+const KNOWN_REQUIREMENTS: &[&str] = &[
+    "strips",
+    "typing",
+    "negative-preconditions",
+    "disjunctive-preconditions",
+    "equality",
+    "existential-preconditions",
+    "universal-preconditions",
+    "quantified-preconditions",
+    "conditional-effects",
+    "fluents",
+    "numeric-fluents",
+    "object-fluents",
+    "adl",
+    "durative-actions",
+    "duration-inequalities",
+    "continuous-effects",
+    "derived-predicates",
+    "timed-initial-literals",
+    "preferences",
+    "constraints",
+    "action-costs",
+    "domain-axioms",
+    "safety-constraints",
+    "expression-evaluation",
+    "open-world",
+    "true-negation",
+    "ucpop",
+    "foreach-expansions",
+    "dag-expansions",
+    "subgoal-through-axioms",
+];
+
+const UNSUPPORTED_REQUIREMENTS: &[&str] = &[
+    "object-fluents",
+    "duration-inequalities",
+    "continuous-effects",
+    "timed-initial-literals",
+    "preferences",
+    "constraints",
+    "domain-axioms",
+    "safety-constraints",
+    "open-world",
+    "true-negation",
+    "foreach-expansions",
+    "dag-expansions",
+    "subgoal-through-axioms",
+    "expression-evaluation",
+];
+
+fn expand_requirement(r: &str, out: &mut FxHashSet<String>) {
+    out.insert(r.to_owned());
+    let implied: &[&str] = match r {
+        "adl" | "ucpop" => &[
+            "strips",
+            "typing",
+            "disjunctive-preconditions",
+            "equality",
+            "quantified-preconditions",
+            "conditional-effects",
+        ],
+        "quantified-preconditions" => &["existential-preconditions", "universal-preconditions"],
+        "fluents" => &["numeric-fluents"],
+        "timed-initial-literals" => &["durative-actions"],
+        _ => &[],
+    };
+    for i in implied {
+        expand_requirement(i, out);
+    }
+}
+
+/// Reads `:requirements` into a set, reporting unknown and unsupported flags.
+fn requirements(reqs: &[Name], diags: &mut Vec<Diagnostic>) -> FxHashSet<String> {
+    let mut set = FxHashSet::default();
+    for r in reqs {
+        if !KNOWN_REQUIREMENTS.contains(&r.as_str()) {
+            let d = Diagnostic::error(
+                codes::UNKNOWN_REQUIREMENT,
+                r.span,
+                format!("`:{}` is not a PDDL requirement", r.name),
+            );
+            diags.push(
+                match did_you_mean(&r.name, KNOWN_REQUIREMENTS.iter().copied()) {
+                    Some(h) => d.with_hint(h),
+                    None => d,
+                },
+            );
+            continue;
+        }
+        if UNSUPPORTED_REQUIREMENTS.contains(&r.as_str()) {
+            diags.push(
+                Diagnostic::error(
+                    codes::UNSUPPORTED,
+                    r.span,
+                    format!("the requirement `:{}` is not supported by btc", r.name),
+                )
+                .with_hint("btc supports STRIPS, typing, ADL conditions and effects, derived predicates, numeric fluents, action costs and durative actions"),
+            );
+        }
+        expand_requirement(&r.name, &mut set);
+    }
+    if reqs.is_empty() {
+        set.insert("strips".into());
+    }
+    set
+}
+
+/// A feature a file uses, for "used but not declared" warnings.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Debug)]
+enum Feature {
+    Typing,
+    Negation,
+    Disjunction,
+    Equality,
+    Existential,
+    Universal,
+    ConditionalEffects,
+    Numeric,
+    Durative,
+    Derived,
+}
+
+impl Feature {
+    /// The requirement flags that allow this feature (any one of them).
+    fn allowed_by(self) -> &'static [&'static str] {
+        match self {
+            Feature::Typing => &["typing"],
+            Feature::Negation => &["negative-preconditions", "disjunctive-preconditions"],
+            Feature::Disjunction => &["disjunctive-preconditions"],
+            Feature::Equality => &["equality"],
+            Feature::Existential => &["existential-preconditions"],
+            Feature::Universal => &["universal-preconditions"],
+            Feature::ConditionalEffects => &["conditional-effects"],
+            Feature::Numeric => &["numeric-fluents", "action-costs"],
+            Feature::Durative => &["durative-actions"],
+            Feature::Derived => &["derived-predicates"],
+        }
+    }
+
+    fn describe(self) -> &'static str {
+        match self {
+            Feature::Typing => "typed names",
+            Feature::Negation => "a negative condition (`not`)",
+            Feature::Disjunction => "a disjunctive condition (`or` / `imply`)",
+            Feature::Equality => "an equality test (`=`)",
+            Feature::Existential => "an `exists` condition",
+            Feature::Universal => "a `forall` condition",
+            Feature::ConditionalEffects => "a conditional or quantified effect (`when` / `forall`)",
+            Feature::Numeric => "numeric functions",
+            Feature::Durative => "a durative action",
+            Feature::Derived => "a derived predicate",
+        }
+    }
+}
+
+/// Where a formula stands; decides what may appear in it.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Place {
+    Condition,
+    Goal,
+    Derived,
+}
+
+struct Checker<'a> {
+    domain: &'a Domain,
+    index: &'a DomainIndex,
+    /// Objects of the problem being checked; `None` while checking the domain.
+    problem: Option<&'a ProblemIndex>,
+    diags: Vec<Diagnostic>,
+    used: FxHashMap<Feature, Span>,
+    durative: bool,
+}
+
+type Scope = Vec<(String, Vec<TypeId>)>;
+
+/// Checks a domain and builds its index.
+pub fn check_domain(domain: &Domain) -> (DomainIndex, Vec<Diagnostic>) {
+    let mut diags = Vec::new();
+    let mut index = DomainIndex {
+        requirements: requirements(&domain.requirements, &mut diags),
+        types: TypeTable::build(domain, &mut diags),
+        ..DomainIndex::default()
+    };
+    let mut used: FxHashMap<Feature, Span> = FxHashMap::default();
+    if let Some(t) = domain.types.first() {
+        used.insert(Feature::Typing, t.name.span);
+    }
+    // Constants
+    for c in &domain.constants {
+        let types = index.types.resolve(&c.ty, &mut diags);
+        note_typed(c, &mut used);
+        if let Some(prev) = index.constants.get(c.name.as_str()) {
+            diags.push(duplicate("constant", &c.name, prev.span));
+            continue;
+        }
+        let id = index.constant_names.len() as u32;
+        index.constant_names.push(c.name.name.clone());
+        index.constants.insert(
+            c.name.name.clone(),
+            ObjectInfo {
+                id,
+                types,
+                span: c.name.span,
+            },
+        );
+    }
+    // Predicates and functions
+    for (i, p) in domain.predicates.iter().enumerate() {
+        let params = resolve_params(&p.params, &index.types, &mut diags, &mut used);
+        if let Some(prev) = index.predicates.get(p.name.as_str()) {
+            diags.push(duplicate("predicate", &p.name, prev.span));
+            continue;
+        }
+        index.predicates.insert(
+            p.name.name.clone(),
+            Signature {
+                index: i,
+                params,
+                span: p.name.span,
+            },
+        );
+    }
+    for (i, f) in domain.functions.iter().enumerate() {
+        used.entry(Feature::Numeric).or_insert(f.name.span);
+        let params = resolve_params(&f.params, &index.types, &mut diags, &mut used);
+        if let Some(prev) = index.functions.get(f.name.as_str()) {
+            diags.push(duplicate("function", &f.name, prev.span));
+            continue;
+        }
+        index.functions.insert(
+            f.name.name.clone(),
+            Signature {
+                index: i,
+                params,
+                span: f.name.span,
+            },
+        );
+    }
+    for (i, a) in domain.actions.iter().enumerate() {
+        let params = resolve_params(&a.params, &index.types, &mut diags, &mut used);
+        if a.durative {
+            used.entry(Feature::Durative).or_insert(a.name.span);
+        }
+        if let Some(prev) = index.actions.get(a.name.as_str()) {
+            diags.push(duplicate("action", &a.name, prev.span));
+            continue;
+        }
+        index.actions.insert(
+            a.name.name.clone(),
+            Signature {
+                index: i,
+                params,
+                span: a.name.span,
+            },
+        );
+    }
+    for d in &domain.derived {
+        used.entry(Feature::Derived).or_insert(d.head.name.span);
+        match index.predicates.get(d.head.name.as_str()) {
+            None => diags.push(
+                Diagnostic::error(
+                    codes::UNKNOWN_PREDICATE,
+                    d.head.name.span,
+                    format!(
+                        "derived predicate `{}` is not declared in `:predicates`",
+                        d.head.name.name
+                    ),
+                )
+                .with_hint(format!("add `{}` to `:predicates`", render_decl(&d.head))),
+            ),
+            Some(sig) if sig.params.len() != d.head.params.len() => diags.push(
+                Diagnostic::error(
+                    codes::WRONG_ARITY,
+                    d.head.span,
+                    format!(
+                        "`{}` is declared with {} parameters but derived with {}",
+                        d.head.name.name,
+                        sig.params.len(),
+                        d.head.params.len()
+                    ),
+                )
+                .with_label(sig.span, "declared here"),
+            ),
+            Some(_) => {}
+        }
+        index.derived.insert(d.head.name.name.clone());
+    }
+    index.derived_strata = stratify(domain, &index, &mut diags);
+
+    let mut c = Checker {
+        domain,
+        index: &index,
+        problem: None,
+        diags: Vec::new(),
+        used,
+        durative: false,
+    };
+    for a in &domain.actions {
+        c.durative = a.durative;
+        let scope = scope_of(&a.params, &index.types);
+        check_duplicate_vars(&a.params, &mut c.diags);
+        for f in a.pre_start.iter().chain(&a.pre_over_all).chain(&a.pre_end) {
+            c.formula(f, &scope, Place::Condition);
+        }
+        for e in a.eff_start.iter().chain(&a.eff_end) {
+            c.effect(e, &scope);
+        }
+        if let Some(d) = &a.duration {
+            c.num_expr(&d.value, &scope);
+        }
+    }
+    c.durative = false;
+    for d in &domain.derived {
+        let scope = scope_of(&d.head.params, &index.types);
+        check_duplicate_vars(&d.head.params, &mut c.diags);
+        c.formula(&d.body, &scope, Place::Derived);
+    }
+    let used = std::mem::take(&mut c.used);
+    diags.append(&mut c.diags);
+    diags.extend(undeclared_requirements(&used, &index.requirements));
+    (index, diags)
+}
+
+/// Checks a problem against its checked domain and builds the object table.
+pub fn check_problem(
+    problem: &Problem,
+    domain: &Domain,
+    index: &DomainIndex,
+) -> (ProblemIndex, Vec<Diagnostic>) {
+    let mut diags = Vec::new();
+    if !problem.domain.name.is_empty() && problem.domain.name != domain.name.name {
+        diags.push(
+            Diagnostic::warning(
+                codes::DOMAIN_MISMATCH,
+                problem.domain.span,
+                format!(
+                    "this problem is for domain `{}`, but it is checked against domain `{}`",
+                    problem.domain.name, domain.name.name
+                ),
+            )
+            .with_label(domain.name.span, "the domain given")
+            .with_hint("pass the problem's own domain file, or fix the name in `(:domain ...)`"),
+        );
+    }
+    let mut reqs = index.requirements.clone();
+    reqs.extend(requirements(&problem.requirements, &mut diags));
+    let mut pi = ProblemIndex::default();
+    for name in &index.constant_names {
+        let info = &index.constants[name];
+        pi.object_names.push(name.clone());
+        pi.object_types.push(info.types.clone());
+        pi.objects.insert(name.clone(), info.clone());
+    }
+    for o in &problem.objects {
+        let types = index.types.resolve(&o.ty, &mut diags);
+        if let Some(prev) = pi.objects.get(o.name.as_str()) {
+            let d = if index.constants.contains_key(o.name.as_str()) {
+                Diagnostic::warning(
+                    codes::DUPLICATE,
+                    o.name.span,
+                    format!("`{}` is already a constant of the domain", o.name.name),
+                )
+                .with_label(prev.span, "declared here")
+            } else {
+                duplicate("object", &o.name, prev.span)
+            };
+            diags.push(d);
+            continue;
+        }
+        let id = pi.object_names.len() as u32;
+        pi.object_names.push(o.name.name.clone());
+        pi.object_types.push(types.clone());
+        pi.objects.insert(
+            o.name.name.clone(),
+            ObjectInfo {
+                id,
+                types,
+                span: o.name.span,
+            },
+        );
+    }
+    let mut c = Checker {
+        domain,
+        index,
+        problem: Some(&pi),
+        diags: Vec::new(),
+        used: FxHashMap::default(),
+        durative: false,
+    };
+    let scope = Scope::new();
+    for fact in &problem.init {
+        match fact {
+            InitFact::Atom { atom } => {
+                if c.index.derived.contains(atom.pred.as_str()) {
+                    c.diags.push(
+                        Diagnostic::error(
+                            codes::DERIVED_EFFECT,
+                            atom.pred.span,
+                            format!(
+                                "`{}` is a derived predicate: it cannot be listed in `:init`",
+                                atom.pred.name
+                            ),
+                        )
+                        .with_hint("derived predicates are computed from the other facts"),
+                    );
+                }
+                c.ground(atom);
+                c.atom(atom, &scope);
+            }
+            InitFact::Value { fluent, .. } => {
+                c.ground(fluent);
+                c.fluent(fluent, &scope);
+            }
+        }
+    }
+    if let Some(g) = &problem.goal {
+        c.formula(g, &scope, Place::Goal);
+    }
+    if let Some(m) = &problem.metric {
+        c.num_expr(&m.expr, &scope);
+    }
+    diags.append(&mut c.diags);
+    diags.extend(undeclared_requirements(&c.used, &reqs));
+    (pi, diags)
+}
+
+fn note_typed(t: &Typed, used: &mut FxHashMap<Feature, Span>) {
+    if !matches!(t.ty, TypeSpec::Object) {
+        used.entry(Feature::Typing).or_insert(t.name.span);
+    }
+}
+
+fn resolve_params(
+    params: &[Typed],
+    types: &TypeTable,
+    diags: &mut Vec<Diagnostic>,
+    used: &mut FxHashMap<Feature, Span>,
+) -> Vec<Vec<TypeId>> {
+    params
+        .iter()
+        .map(|p| {
+            note_typed(p, used);
+            types.resolve(&p.ty, diags)
+        })
+        .collect()
+}
+
+/// Variables' types without reporting again (resolve_params reported).
+fn scope_of(params: &[Typed], types: &TypeTable) -> Scope {
+    params
+        .iter()
+        .map(|p| (p.name.name.clone(), types.resolve(&p.ty, &mut Vec::new())))
+        .collect()
+}
+
+fn check_duplicate_vars(params: &[Typed], diags: &mut Vec<Diagnostic>) {
+    let mut seen: FxHashMap<&str, Span> = FxHashMap::default();
+    for p in params {
+        if let Some(prev) = seen.insert(p.name.as_str(), p.name.span) {
+            diags.push(duplicate(
+                "parameter",
+                &Name {
+                    name: format!("?{}", p.name.name),
+                    span: p.name.span,
+                },
+                prev,
+            ));
+        }
+    }
+}
+
+fn duplicate(what: &str, name: &Name, first: Span) -> Diagnostic {
+    Diagnostic::error(
+        codes::DUPLICATE,
+        name.span,
+        format!("{what} `{}` is defined twice", name.name),
+    )
+    .with_label(first, "first defined here")
+    .with_hint("remove or rename one of them")
+}
+
+fn render_decl(p: &PredicateDecl) -> String {
+    let mut s = format!("({}", p.name.name);
+    for t in &p.params {
+        s.push_str(&format!(" ?{} - {}", t.name.name, t.ty));
+    }
+    s.push(')');
+    s
+}
+
+fn undeclared_requirements(
+    used: &FxHashMap<Feature, Span>,
+    declared: &FxHashSet<String>,
+) -> Vec<Diagnostic> {
+    let mut out: Vec<Diagnostic> = used
+        .iter()
+        .filter(|(f, _)| !f.allowed_by().iter().any(|r| declared.contains(*r)))
+        .map(|(f, span)| {
+            let flag = f.allowed_by()[0];
+            Diagnostic::warning(
+                codes::UNDECLARED_REQUIREMENT,
+                *span,
+                format!(
+                    "{} needs the requirement `:{flag}`, which is not declared",
+                    f.describe()
+                ),
+            )
+            .with_hint(format!("add `:{flag}` to `(:requirements ...)`"))
+        })
+        .collect();
+    out.sort_by_key(|d| d.span.start);
+    out
+}
+
+impl Checker<'_> {
+    fn use_feature(&mut self, f: Feature, span: Span) {
+        self.used.entry(f).or_insert(span);
+    }
+
+    fn term(&mut self, t: &Term, scope: &Scope) -> Option<Vec<TypeId>> {
+        match t {
+            Term::Var { name } => match scope.iter().rev().find(|(v, _)| *v == name.name) {
+                Some((_, types)) => Some(types.clone()),
+                None => {
+                    let d = Diagnostic::error(
+                        codes::UNBOUND_VARIABLE,
+                        name.span,
+                        format!("variable `?{}` is not bound here", name.name),
+                    );
+                    let hint = crate::diagnostic::closest(
+                        &name.name,
+                        scope.iter().map(|(v, _)| v.as_str()),
+                    )
+                    .map(|c| format!("did you mean `?{c}`?"))
+                    .unwrap_or_else(|| "declare it in `:parameters` or in a quantifier".into());
+                    self.diags.push(d.with_hint(hint));
+                    None
+                }
+            },
+            Term::Const { name } => {
+                if let Some(o) = self.problem.and_then(|p| p.objects.get(name.as_str())) {
+                    return Some(o.types.clone());
+                }
+                if let Some(c) = self.index.constants.get(name.as_str()) {
+                    return Some(c.types.clone());
+                }
+                let (what, hint) = match self.problem {
+                    Some(p) => (
+                        "an object of the problem or a constant of the domain",
+                        did_you_mean(&name.name, p.object_names.iter().map(String::as_str)),
+                    ),
+                    None => (
+                        "a constant of the domain",
+                        did_you_mean(
+                            &name.name,
+                            self.index.constant_names.iter().map(String::as_str),
+                        ),
+                    ),
+                };
+                let d = Diagnostic::error(
+                    codes::UNKNOWN_OBJECT,
+                    name.span,
+                    format!("`{}` is not {what}", name.name),
+                );
+                self.diags.push(match hint {
+                    Some(h) => d.with_hint(h),
+                    None if self.problem.is_none() => d.with_hint(format!(
+                        "declare it in `(:constants ...)`, or use a variable `?{}`",
+                        name.name
+                    )),
+                    None => d.with_hint("declare it in `(:objects ...)`"),
+                });
+                None
+            }
+        }
+    }
+
+    /// Terms in `:init` must be objects.
+    fn ground(&mut self, atom: &Atom) {
+        for a in &atom.args {
+            if let Term::Var { name } = a {
+                self.diags.push(Diagnostic::error(
+                    codes::NOT_GROUND,
+                    name.span,
+                    format!(
+                        "`?{}` is a variable, but `:init` lists facts about objects",
+                        name.name
+                    ),
+                ));
+            }
+        }
+    }
+
+    fn args(&mut self, what: &str, atom: &Atom, sig: &Signature, decl_span: Span, scope: &Scope) {
+        if atom.args.len() != sig.params.len() {
+            let n = sig.params.len();
+            self.diags.push(
+                Diagnostic::error(
+                    codes::WRONG_ARITY,
+                    atom.span,
+                    format!(
+                        "{what} `{}` takes {n} argument{}, but {} {} given",
+                        atom.pred.name,
+                        if n == 1 { "" } else { "s" },
+                        atom.args.len(),
+                        if atom.args.len() == 1 { "is" } else { "are" }
+                    ),
+                )
+                .with_label(decl_span, "declared here"),
+            );
+            for a in &atom.args {
+                self.term(a, scope);
+            }
+            return;
+        }
+        for (i, (a, want)) in atom.args.iter().zip(&sig.params).enumerate() {
+            let Some(have) = self.term(a, scope) else {
+                continue;
+            };
+            if !self.index.types.fits(&have, want) {
+                let t = &self.index.types;
+                self.diags.push(
+                    Diagnostic::error(
+                        codes::TYPE_MISMATCH,
+                        a.span(),
+                        format!(
+                            "`{a}` has type `{}`, but argument {} of `{}` must be `{}`",
+                            t.display(&have),
+                            i + 1,
+                            atom.pred.name,
+                            t.display(want)
+                        ),
+                    )
+                    .with_label(decl_span, "declared here"),
+                );
+            }
+        }
+    }
+
+    fn atom(&mut self, atom: &Atom, scope: &Scope) {
+        match self.index.predicates.get(atom.pred.as_str()) {
+            Some(sig) => {
+                let span = self.domain.predicates[sig.index].span;
+                self.args("predicate", atom, sig, span, scope)
+            }
+            None => {
+                let d = Diagnostic::error(
+                    codes::UNKNOWN_PREDICATE,
+                    atom.pred.span,
+                    format!(
+                        "predicate `{}` is not declared in the domain",
+                        atom.pred.name
+                    ),
+                );
+                let hint = did_you_mean(
+                    &atom.pred.name,
+                    self.index.predicates.keys().map(String::as_str),
+                )
+                .unwrap_or_else(|| "declare it in `(:predicates ...)`".into());
+                self.diags.push(d.with_hint(hint));
+                for a in &atom.args {
+                    self.term(a, scope);
+                }
+            }
+        }
+    }
+
+    fn fluent(&mut self, app: &Atom, scope: &Scope) {
+        self.use_feature(Feature::Numeric, app.span);
+        match self.index.functions.get(app.pred.as_str()) {
+            Some(sig) => {
+                let span = self.domain.functions[sig.index].span;
+                self.args("function", app, sig, span, scope)
+            }
+            None if app.pred.name == "total-time" && app.args.is_empty() => {}
+            None => {
+                let d = Diagnostic::error(
+                    codes::UNKNOWN_FUNCTION,
+                    app.pred.span,
+                    format!("function `{}` is not declared in the domain", app.pred.name),
+                );
+                let hint = did_you_mean(
+                    &app.pred.name,
+                    self.index.functions.keys().map(String::as_str),
+                )
+                .unwrap_or_else(|| "declare it in `(:functions ...)`".into());
+                self.diags.push(d.with_hint(hint));
+            }
+        }
+    }
+
+    fn num_expr(&mut self, e: &NumExpr, scope: &Scope) {
+        match e {
+            NumExpr::Number { .. } => {}
+            NumExpr::Fluent { app } => self.fluent(app, scope),
+            NumExpr::Duration { span } => {
+                if !self.durative {
+                    self.diags.push(Diagnostic::error(
+                        codes::UNBOUND_VARIABLE,
+                        *span,
+                        "`?duration` exists only in durative actions",
+                    ));
+                }
+            }
+            NumExpr::Binary { left, right, .. } => {
+                self.num_expr(left, scope);
+                self.num_expr(right, scope);
+            }
+            NumExpr::Neg { expr, .. } => self.num_expr(expr, scope),
+        }
+    }
+
+    fn quantified(&mut self, vars: &[Typed], scope: &Scope) -> Scope {
+        check_duplicate_vars(vars, &mut self.diags);
+        let mut inner = scope.clone();
+        for v in vars {
+            inner.push((
+                v.name.name.clone(),
+                self.index.types.resolve(&v.ty, &mut self.diags),
+            ));
+            note_typed(v, &mut self.used);
+        }
+        inner
+    }
+
+    fn formula(&mut self, f: &Formula, scope: &Scope, place: Place) {
+        match f {
+            Formula::Atom { atom } => self.atom(atom, scope),
+            Formula::Equal { left, right, span } => {
+                self.use_feature(Feature::Equality, *span);
+                self.term(left, scope);
+                self.term(right, scope);
+            }
+            Formula::Not { formula, span } => {
+                self.use_feature(Feature::Negation, *span);
+                self.formula(formula, scope, place);
+            }
+            Formula::And { parts, .. } => {
+                for p in parts {
+                    self.formula(p, scope, place);
+                }
+            }
+            Formula::Or { parts, span } => {
+                self.use_feature(Feature::Disjunction, *span);
+                for p in parts {
+                    self.formula(p, scope, place);
+                }
+            }
+            Formula::Imply { left, right, span } => {
+                self.use_feature(Feature::Disjunction, *span);
+                self.formula(left, scope, place);
+                self.formula(right, scope, place);
+            }
+            Formula::Exists { vars, body, span } => {
+                self.use_feature(Feature::Existential, *span);
+                let inner = self.quantified(vars, scope);
+                self.formula(body, &inner, place);
+            }
+            Formula::Forall { vars, body, span } => {
+                self.use_feature(Feature::Universal, *span);
+                let inner = self.quantified(vars, scope);
+                self.formula(body, &inner, place);
+            }
+            Formula::Compare { left, right, .. } => {
+                self.num_expr(left, scope);
+                self.num_expr(right, scope);
+            }
+        }
+    }
+
+    fn effect(&mut self, e: &Effect, scope: &Scope) {
+        match e {
+            Effect::Add { atom } | Effect::Delete { atom, .. } => {
+                if self.index.derived.contains(atom.pred.as_str()) {
+                    self.diags.push(
+                        Diagnostic::error(
+                            codes::DERIVED_EFFECT,
+                            atom.pred.span,
+                            format!(
+                                "`{}` is a derived predicate: actions cannot change it",
+                                atom.pred.name
+                            ),
+                        )
+                        .with_hint("change the facts it is derived from instead"),
+                    );
+                }
+                self.atom(atom, scope)
+            }
+            Effect::And { parts, .. } => {
+                for p in parts {
+                    self.effect(p, scope);
+                }
+            }
+            Effect::Forall { vars, body, span } => {
+                self.use_feature(Feature::ConditionalEffects, *span);
+                let inner = self.quantified(vars, scope);
+                self.effect(body, &inner);
+            }
+            Effect::When {
+                condition,
+                body,
+                span,
+            } => {
+                self.use_feature(Feature::ConditionalEffects, *span);
+                self.formula(condition, scope, Place::Condition);
+                self.effect(body, scope);
+            }
+            Effect::Numeric { fluent, value, .. } => {
+                self.fluent(fluent, scope);
+                self.num_expr(value, scope);
+            }
+        }
+    }
+}
+
+/// Orders derived predicates into strata (stratified negation), reporting
+/// predicates that depend negatively on themselves.
+fn stratify(domain: &Domain, index: &DomainIndex, diags: &mut Vec<Diagnostic>) -> Vec<Vec<usize>> {
+    let n = domain.derived.len();
+    if n == 0 {
+        return Vec::new();
+    }
+    let pos_of = |name: &str| domain.derived.iter().position(|d| d.head.name.name == name);
+    // edges[i]: (j, negative) — rule i's body mentions derived predicate j.
+    let edges: Vec<Vec<(usize, bool)>> = domain
+        .derived
+        .iter()
+        .map(|d| {
+            let mut out = Vec::new();
+            collect_derived_uses(&d.body, true, &mut |name, positive| {
+                if index.derived.contains(name) {
+                    if let Some(j) = pos_of(name) {
+                        out.push((j, !positive));
+                    }
+                }
+            });
+            out
+        })
+        .collect();
+    let mut level = vec![0usize; n];
+    // Bellman-Ford style relaxation; a level above n means a negative cycle.
+    for _ in 0..=n {
+        let mut changed = false;
+        for i in 0..n {
+            for &(j, neg) in &edges[i] {
+                let need = level[j] + usize::from(neg);
+                if level[i] < need {
+                    level[i] = need;
+                    changed = true;
+                }
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+    if level.iter().any(|&l| l > n) || has_negative_cycle(&edges, n) {
+        let d = &domain.derived[0];
+        diags.push(
+            Diagnostic::error(
+                codes::NOT_STRATIFIED,
+                d.head.name.span,
+                "derived predicates depend on their own negation",
+            )
+            .with_hint("rewrite the `:derived` rules so no predicate depends on its own negation"),
+        );
+        return vec![(0..n).collect()];
+    }
+    let max = level.iter().copied().max().unwrap_or(0);
+    // Several rules may derive the same predicate: they share a level.
+    (0..=max)
+        .map(|l| (0..n).filter(|&i| level[i] == l).collect())
+        .filter(|v: &Vec<usize>| !v.is_empty())
+        .collect()
+}
+
+fn has_negative_cycle(edges: &[Vec<(usize, bool)>], n: usize) -> bool {
+    // A negative edge i -> j where j reaches i makes the program unstratifiable.
+    let reach = |from: usize, to: usize| {
+        let mut seen = vec![false; n];
+        let mut stack = vec![from];
+        while let Some(x) = stack.pop() {
+            if x == to {
+                return true;
+            }
+            if !std::mem::replace(&mut seen[x], true) {
+                stack.extend(edges[x].iter().map(|e| e.0));
+            }
+        }
+        false
+    };
+    (0..n).any(|i| edges[i].iter().any(|&(j, neg)| neg && reach(j, i)))
+}
+
+/// Calls `f(predicate, positive)` for each atom in a formula.
+pub fn collect_derived_uses(f: &Formula, positive: bool, out: &mut impl FnMut(&str, bool)) {
+    match f {
+        Formula::Atom { atom } => out(atom.pred.as_str(), positive),
+        Formula::Not { formula, .. } => collect_derived_uses(formula, !positive, out),
+        Formula::And { parts, .. } | Formula::Or { parts, .. } => {
+            for p in parts {
+                collect_derived_uses(p, positive, out);
+            }
+        }
+        Formula::Imply { left, right, .. } => {
+            collect_derived_uses(left, !positive, out);
+            collect_derived_uses(right, positive, out);
+        }
+        Formula::Exists { body, .. } | Formula::Forall { body, .. } => {
+            collect_derived_uses(body, positive, out)
+        }
+        Formula::Equal { .. } | Formula::Compare { .. } => {}
+    }
+}
