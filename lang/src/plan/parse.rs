@@ -1,0 +1,419 @@
+//! Reads the plan formats people actually have, line by line. Each line is
+//! recognised by its shape, so files that mix headers and steps (planner
+//! stdout) read as well as clean `sas_plan` files.
+//!
+//! Hand-written rather than built with chumsky: plans are line-oriented, each
+//! line's shape decides its format, and reading must run at millions of steps
+//! per second.
+
+use crate::diagnostic::{codes, Diagnostic};
+use crate::pddl::ast::Name;
+use crate::source::{FileId, Span};
+use serde::Serialize;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum PlanFormat {
+    /// Fast Downward / pyperplan: `(move a b)` lines, `; cost = N` footer.
+    SasPlan,
+    /// Temporal planners (OPTIC, POPF, LPG, PlanSys2): `0.000: (move a b) [1.000]`.
+    Timed,
+    /// Bare `move a b` lines, as printed in the ARIAC paper.
+    Bare,
+    /// FF's stdout: `step    0: PICK-UP B`, then `        1: STACK B A`.
+    Ff,
+    /// No steps at all.
+    Empty,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct PlanStep {
+    pub action: Name,
+    pub args: Vec<Name>,
+    pub time: Option<f64>,
+    pub duration: Option<f64>,
+    /// 1-based line number in the plan file.
+    pub line: u32,
+    /// The step as written, from its action name (or `(`) to its end.
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct StatedCost {
+    pub value: f64,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Plan {
+    pub format: PlanFormat,
+    pub steps: Vec<PlanStep>,
+    /// `; cost = N (...)` when the planner stated one.
+    pub stated_cost: Option<StatedCost>,
+}
+
+/// Reads a plan. Lines that cannot be read are reported with their line and
+/// column; the others are still returned.
+pub fn parse_plan(text: &str, file: FileId) -> (Plan, Vec<Diagnostic>) {
+    let mut plan = Plan {
+        format: PlanFormat::Empty,
+        steps: Vec::new(),
+        stated_cost: None,
+    };
+    let mut diags = Vec::new();
+    let mut offset = 0usize;
+    let mut in_ff = false;
+    for (i, raw) in text.split('\n').enumerate() {
+        let line_start = offset;
+        offset += raw.len() + 1;
+        let line = raw.strip_suffix('\r').unwrap_or(raw);
+        let mut l = LineReader {
+            text: line,
+            pos: 0,
+            base: line_start,
+            file,
+            line: i as u32 + 1,
+        };
+        match l.read(&mut in_ff) {
+            Ok(Line::Blank) => {}
+            Ok(Line::Comment) => {
+                if let Some(c) = stated_cost(line, line_start, file) {
+                    plan.stated_cost = Some(c);
+                }
+            }
+            Ok(Line::Step(format, step)) => {
+                if plan.format == PlanFormat::Empty {
+                    plan.format = format;
+                }
+                plan.steps.push(step);
+            }
+            Err(d) => diags.push(d),
+        }
+    }
+    if plan.steps.iter().any(|s| s.time.is_some()) {
+        // Temporal planners do not always print in time order (LPG).
+        plan.steps.sort_by(|a, b| {
+            let (x, y) = (a.time.unwrap_or(0.0), b.time.unwrap_or(0.0));
+            x.total_cmp(&y)
+        });
+    }
+    (plan, diags)
+}
+
+enum Line {
+    Blank,
+    Comment,
+    Step(PlanFormat, PlanStep),
+}
+
+struct LineReader<'a> {
+    text: &'a str,
+    pos: usize,
+    base: usize,
+    file: FileId,
+    line: u32,
+}
+
+fn lower(s: &str) -> String {
+    if s.is_ascii() {
+        s.to_ascii_lowercase()
+    } else {
+        s.to_lowercase()
+    }
+}
+
+fn is_word_byte(b: u8) -> bool {
+    !(b.is_ascii_whitespace() || b == b'(' || b == b')' || b == b'[' || b == b']' || b == b';')
+}
+
+impl<'a> LineReader<'a> {
+    fn span(&self, start: usize, end: usize) -> Span {
+        Span::new(self.file, self.base + start, self.base + end)
+    }
+
+    fn error(&self, at: usize, end: usize, message: impl Into<String>) -> Diagnostic {
+        let end = end.max(at).min(self.text.len());
+        Diagnostic::error(codes::PLAN_SYNTAX, self.span(at, end), message)
+    }
+
+    fn skip_ws(&mut self) {
+        let b = self.text.as_bytes();
+        while self.pos < b.len() && b[self.pos].is_ascii_whitespace() {
+            self.pos += 1;
+        }
+    }
+
+    fn peek(&self) -> Option<u8> {
+        self.text.as_bytes().get(self.pos).copied()
+    }
+
+    /// A run of word characters; `None` at a delimiter or the end.
+    fn word(&mut self) -> Option<(usize, &'a str)> {
+        let text = self.text;
+        let b = text.as_bytes();
+        let start = self.pos;
+        while self.pos < b.len() && is_word_byte(b[self.pos]) {
+            self.pos += 1;
+        }
+        (self.pos > start).then(|| (start, &text[start..self.pos]))
+    }
+
+    fn name(&self, start: usize, w: &str) -> Result<Name, Diagnostic> {
+        if let Some(c) = w.chars().find(|c| !(c.is_alphanumeric() || matches!(c, '-' | '_' | '.' | '@'))) {
+            return Err(self
+                .error(start, start + w.len(), format!("`{w}` is not a PDDL name: `{c}` is not allowed in names"))
+                .with_hint("plan steps are `(action arg ...)`, `TIME: (action arg ...) [DURATION]` or `action arg ...`"));
+        }
+        Ok(Name {
+            name: lower(w),
+            span: self.span(start, start + w.len()),
+        })
+    }
+
+    fn read(&mut self, in_ff: &mut bool) -> Result<Line, Diagnostic> {
+        self.skip_ws();
+        match self.peek() {
+            None => return Ok(Line::Blank),
+            Some(b';') => return Ok(Line::Comment),
+            Some(b'(') => return self.parenthesised(None).map(|s| Line::Step(PlanFormat::SasPlan, s)),
+            _ => {}
+        }
+        let save = self.pos;
+        let (wstart, first) = self.word().expect("not at a delimiter");
+        // `step 0: NAME ARGS` (FF)
+        if first.eq_ignore_ascii_case("step") {
+            self.skip_ws();
+            if let Some((_, n)) = self.word() {
+                if let Some(num) = n.strip_suffix(':').or_else(|| self.colon_after(n)) {
+                    if num.bytes().all(|b| b.is_ascii_digit()) && !num.is_empty() {
+                        *in_ff = true;
+                        return self.bare().map(|s| Line::Step(PlanFormat::Ff, s));
+                    }
+                }
+            }
+            self.pos = save;
+        }
+        // `TIME: (...)`, `N: NAME ARGS` (FF continuation) or `Header: ...`
+        if let Some(head) = first.strip_suffix(':').or_else(|| self.colon_after(first)) {
+            if let Ok(time) = head.parse::<f64>() {
+                if !head.starts_with(['+', '-']) && time.is_finite() {
+                    self.skip_ws();
+                    if self.peek() == Some(b'(') {
+                        return self.parenthesised(Some(time)).map(|s| Line::Step(PlanFormat::Timed, s));
+                    }
+                    if *in_ff {
+                        return self.bare().map(|s| Line::Step(PlanFormat::Ff, s));
+                    }
+                    return Err(self
+                        .error(wstart, self.text.len(), "expected `(action arg ...)` after the time")
+                        .with_hint("timed plans read `0.000: (action arg ...) [1.000]`"));
+                }
+            }
+            if head.bytes().next().is_some_and(|b| b.is_ascii_alphabetic()) {
+                return Ok(Line::Comment); // `Time: 0.01s`, `Plan:`, `ff: found legal plan`
+            }
+        }
+        // A line of words: a header (`found legal plan as follows:`) or a bare step.
+        if self.text.trim_end().ends_with(':') || self.text.contains(": ") {
+            return Ok(Line::Comment);
+        }
+        self.pos = save;
+        self.bare().map(|s| Line::Step(PlanFormat::Bare, s))
+    }
+
+    /// For `3 :` written with a space: consumes the `:` and returns the word.
+    fn colon_after(&mut self, w: &'a str) -> Option<&'a str> {
+        let save = self.pos;
+        self.skip_ws();
+        if self.peek() == Some(b':') {
+            self.pos += 1;
+            return Some(w);
+        }
+        self.pos = save;
+        None
+    }
+
+    /// `name arg arg ...` up to the end of the line.
+    fn bare(&mut self) -> Result<PlanStep, Diagnostic> {
+        self.skip_ws();
+        let start = self.pos;
+        let mut words = Vec::new();
+        loop {
+            self.skip_ws();
+            match self.word() {
+                Some((s, w)) => words.push(self.name(s, w)?),
+                None => break,
+            }
+        }
+        if self.pos < self.text.len() {
+            let at = self.pos;
+            return Err(self.error(at, at + 1, format!("unexpected `{}` in a plan step", &self.text[at..at + 1])));
+        }
+        if words.is_empty() {
+            return Err(self.error(start, self.text.len(), "expected an action name"));
+        }
+        let action = words.remove(0);
+        Ok(PlanStep {
+            span: action.span.to(words.last().map_or(action.span, |w| w.span)),
+            action,
+            args: words,
+            time: None,
+            duration: None,
+            line: self.line,
+        })
+    }
+
+    /// `(name arg ...)` then, optionally, `[duration]` and a `;` comment.
+    fn parenthesised(&mut self, time: Option<f64>) -> Result<PlanStep, Diagnostic> {
+        let open = self.pos;
+        self.pos += 1;
+        let mut words = Vec::new();
+        loop {
+            self.skip_ws();
+            match self.peek() {
+                Some(b')') => break,
+                None => {
+                    return Err(self
+                        .error(open, open + 1, "this `(` is not closed on its line")
+                        .with_hint("each plan step is one line: `(action arg ...)`"))
+                }
+                _ => match self.word() {
+                    Some((s, w)) => words.push(self.name(s, w)?),
+                    None => {
+                        let at = self.pos;
+                        return Err(self.error(at, at + 1, format!("unexpected `{}` in a plan step", &self.text[at..at + 1])));
+                    }
+                },
+            }
+        }
+        let close = self.pos;
+        self.pos += 1;
+        if words.is_empty() {
+            return Err(self.error(open, close + 1, "this step has no action name"));
+        }
+        self.skip_ws();
+        let mut duration = None;
+        if self.peek() == Some(b'[') {
+            duration = Some(self.duration()?);
+            self.skip_ws();
+        }
+        if let Some(b) = self.peek() {
+            if b != b';' {
+                let at = self.pos;
+                return Err(self.error(at, self.text.len(), "unexpected text after the step").with_hint("a step may be followed only by `[DURATION]` and a `;` comment"));
+            }
+        }
+        let action = words.remove(0);
+        Ok(PlanStep {
+            action,
+            args: words,
+            time,
+            duration,
+            line: self.line,
+            span: self.span(open, close + 1),
+        })
+    }
+
+    /// `[1.000]` or LPG's `[D:1.00; C:4099.73]`.
+    fn duration(&mut self) -> Result<f64, Diagnostic> {
+        let open = self.pos;
+        let Some(len) = self.text[open..].find(']') else {
+            return Err(self.error(open, self.text.len(), "this `[` is not closed"));
+        };
+        let inner = &self.text[open + 1..open + len];
+        self.pos = open + len + 1;
+        let value = inner
+            .split(';')
+            .map(str::trim)
+            .find_map(|part| part.strip_prefix("D:").or_else(|| part.strip_prefix("d:")))
+            .unwrap_or(inner)
+            .trim();
+        value.parse::<f64>().ok().filter(|d| d.is_finite() && *d >= 0.0).ok_or_else(|| {
+            self.error(open, open + len + 1, format!("`{inner}` is not a duration"))
+                .with_hint("durations read `[1.000]` (or LPG's `[D:1.00; C:3.00]`)")
+        })
+    }
+}
+
+/// `; cost = 4 (unit cost)` as Fast Downward writes it.
+fn stated_cost(line: &str, base: usize, file: FileId) -> Option<StatedCost> {
+    let start = line.find("cost")?;
+    let rest = line[start + 4..].trim_start().strip_prefix('=')?.trim_start();
+    let end = rest.find(|c: char| c.is_whitespace()).unwrap_or(rest.len());
+    let value = rest[..end].parse::<f64>().ok()?;
+    Some(StatedCost {
+        value,
+        span: Span::new(file, base + start, base + line.trim_end().len()),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn steps(text: &str) -> (PlanFormat, Vec<String>, Vec<Diagnostic>) {
+        let (plan, diags) = parse_plan(text, 0);
+        let s = plan
+            .steps
+            .iter()
+            .map(|s| {
+                let mut out = s.action.name.clone();
+                for a in &s.args {
+                    out.push(' ');
+                    out.push_str(&a.name);
+                }
+                out
+            })
+            .collect();
+        (plan.format, s, diags)
+    }
+
+    #[test]
+    fn reads_sas_plan_and_cost() {
+        let (plan, diags) = parse_plan("(pick ball1 rooma left)\r\n(wait )\n; cost = 4 (unit cost)\n", 0);
+        assert!(diags.is_empty());
+        assert_eq!(plan.format, PlanFormat::SasPlan);
+        assert_eq!(plan.steps.len(), 2);
+        assert!(plan.steps[1].args.is_empty());
+        assert_eq!(plan.stated_cost.as_ref().unwrap().value, 4.0);
+        assert_eq!(plan.steps[0].span, Span::new(0, 0, 23));
+    }
+
+    #[test]
+    fn reads_the_ariac_listing() {
+        let text = "Time: 0.013570785522460938s\nPlan:\nmove floor_robot curr_position bin1\ngrasp floor_robot battery_red bin1\n";
+        let (format, s, diags) = steps(text);
+        assert!(diags.is_empty(), "{diags:?}");
+        assert_eq!(format, PlanFormat::Bare);
+        assert_eq!(s, vec!["move floor_robot curr_position bin1", "grasp floor_robot battery_red bin1"]);
+    }
+
+    #[test]
+    fn reads_timed_variants_and_sorts_by_time() {
+        let text = "; Version LPG-td-1.4\n; Time 0.01\n\n2.0003:   (WALK DRIVER2 S0 P2-0) [D:1.00; C:4099.73]\n0.0003:   (BOARD T1 DRIVER1 S0) [D:1.00; C:1.00]\n5.001: (navigate r w1 w3)  [5.000]\n0:\t(load r h c1)\t[2]\n";
+        let (plan, diags) = parse_plan(text, 0);
+        assert!(diags.is_empty(), "{diags:?}");
+        assert_eq!(plan.format, PlanFormat::Timed);
+        let names: Vec<_> = plan.steps.iter().map(|s| s.action.name.as_str()).collect();
+        assert_eq!(names, vec!["load", "board", "walk", "navigate"]);
+        assert_eq!(plan.steps[2].duration, Some(1.0));
+        assert_eq!(plan.steps[3].line, 6);
+    }
+
+    #[test]
+    fn reads_ff_stdout() {
+        let text = "ff: found legal plan as follows\n\nstep    0: PICK-UP B\n        1: STACK B A\n     \ntime spent:    0.00 seconds instantiating 12 easy, 0 hard action templates\n";
+        let (format, s, diags) = steps(text);
+        assert!(diags.is_empty(), "{diags:?}");
+        assert_eq!(format, PlanFormat::Ff);
+        assert_eq!(s, vec!["pick-up b", "stack b a"]);
+    }
+
+    #[test]
+    fn reports_bad_lines_with_position_and_keeps_going() {
+        let (plan, diags) = parse_plan("(move a b\n(pick \"x\")\n(ok a)\n0.0: (x) [abc]\n", 0);
+        assert_eq!(plan.steps.len(), 1);
+        let at: Vec<_> = diags.iter().map(|d| (d.code, d.span.start)).collect();
+        assert_eq!(at, vec![("L001", 0), ("L001", 16), ("L001", 37)]);
+    }
+}

@@ -1,0 +1,126 @@
+//! Resolves every plan argument to an object of the problem (or a constant
+//! of the domain) and checks it against the action's parameter types, as the
+//! NIST executor does with the problem's `:objects`.
+
+use super::parse::{Plan, PlanStep};
+use crate::diagnostic::{codes, did_you_mean, Diagnostic};
+use crate::pddl::ast::Domain;
+use crate::pddl::check::{DomainIndex, ProblemIndex};
+use serde::Serialize;
+
+/// A plan step with its action and arguments resolved to ids.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct GroundStep {
+    /// Index into `plan.steps`.
+    pub step: usize,
+    /// Index into `domain.actions`.
+    pub action: usize,
+    /// Object ids (see [`ProblemIndex::object_names`]).
+    pub args: Vec<u32>,
+}
+
+/// Types every step; steps with an error are left out of the result and
+/// reported at their plan line.
+pub fn type_plan(
+    plan: &Plan,
+    domain: &Domain,
+    dix: &DomainIndex,
+    pix: &ProblemIndex,
+) -> (Vec<GroundStep>, Vec<Diagnostic>) {
+    let mut out = Vec::with_capacity(plan.steps.len());
+    let mut diags = Vec::new();
+    for (i, step) in plan.steps.iter().enumerate() {
+        if let Some(g) = type_step(i, step, domain, dix, pix, &mut diags) {
+            out.push(g);
+        }
+    }
+    (out, diags)
+}
+
+fn type_step(
+    i: usize,
+    step: &PlanStep,
+    domain: &Domain,
+    dix: &DomainIndex,
+    pix: &ProblemIndex,
+    diags: &mut Vec<Diagnostic>,
+) -> Option<GroundStep> {
+    let Some(sig) = dix.actions.get(step.action.as_str()) else {
+        let d = Diagnostic::error(
+            codes::PLAN_UNKNOWN_ACTION,
+            step.action.span,
+            format!("step {}: the domain has no action `{}`", i + 1, step.action.name),
+        );
+        diags.push(match did_you_mean(&step.action.name, dix.actions.keys().map(String::as_str)) {
+            Some(h) => d.with_hint(h),
+            None => d.with_hint("is this plan for another domain?"),
+        });
+        return None;
+    };
+    let action = &domain.actions[sig.index];
+    if step.args.len() != sig.params.len() {
+        let params: Vec<String> = action.params.iter().map(|p| format!("?{} - {}", p.name.name, p.ty)).collect();
+        diags.push(
+            Diagnostic::error(
+                codes::PLAN_ARITY,
+                step.span,
+                format!(
+                    "step {}: `{}` takes {} argument{}, but the plan gives {}",
+                    i + 1,
+                    step.action.name,
+                    sig.params.len(),
+                    if sig.params.len() == 1 { "" } else { "s" },
+                    step.args.len()
+                ),
+            )
+            .with_label(action.name.span, format!("`{}` is declared here", step.action.name))
+            .with_hint(format!("its parameters are ({})", params.join(" "))),
+        );
+        return None;
+    }
+    let mut args = Vec::with_capacity(step.args.len());
+    let mut ok = true;
+    for (k, (arg, want)) in step.args.iter().zip(&sig.params).enumerate() {
+        let Some(obj) = pix.objects.get(arg.as_str()) else {
+            let d = Diagnostic::error(
+                codes::PLAN_UNKNOWN_OBJECT,
+                arg.span,
+                format!("step {}: `{}` is not an object of the problem or a constant of the domain", i + 1, arg.name),
+            );
+            diags.push(match did_you_mean(&arg.name, pix.object_names.iter().map(String::as_str)) {
+                Some(h) => d.with_hint(h),
+                None => d.with_hint("is this plan for another problem?"),
+            });
+            ok = false;
+            continue;
+        };
+        if !dix.types.fits(&obj.types, want) {
+            let p = &action.params[k];
+            diags.push(
+                Diagnostic::error(
+                    codes::PLAN_TYPE,
+                    arg.span,
+                    format!(
+                        "step {}: `{}` is a `{}`, but parameter `?{}` of `{}` takes a `{}`",
+                        i + 1,
+                        arg.name,
+                        dix.types.display(&obj.types),
+                        p.name.name,
+                        step.action.name,
+                        dix.types.display(want)
+                    ),
+                )
+                .with_label(obj.span, format!("`{}` is declared here", arg.name))
+                .with_label(p.name.span, "the parameter is declared here"),
+            );
+            ok = false;
+            continue;
+        }
+        args.push(obj.id);
+    }
+    ok.then_some(GroundStep {
+        step: i,
+        action: sig.index,
+        args,
+    })
+}
