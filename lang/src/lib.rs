@@ -8,7 +8,9 @@
 
 pub mod diagnostic;
 pub mod pddl;
+pub mod pipeline;
 pub mod plan;
 pub mod render;
 pub mod source;
+pub mod state;
 pub mod validate;

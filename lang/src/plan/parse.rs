@@ -159,7 +159,10 @@ impl<'a> LineReader<'a> {
     }
 
     fn name(&self, start: usize, w: &str) -> Result<Name, Diagnostic> {
-        if let Some(c) = w.chars().find(|c| !(c.is_alphanumeric() || matches!(c, '-' | '_' | '.' | '@'))) {
+        if let Some(c) = w
+            .chars()
+            .find(|c| !(c.is_alphanumeric() || matches!(c, '-' | '_' | '.' | '@')))
+        {
             return Err(self
                 .error(start, start + w.len(), format!("`{w}` is not a PDDL name: `{c}` is not allowed in names"))
                 .with_hint("plan steps are `(action arg ...)`, `TIME: (action arg ...) [DURATION]` or `action arg ...`"));
@@ -175,7 +178,11 @@ impl<'a> LineReader<'a> {
         match self.peek() {
             None => return Ok(Line::Blank),
             Some(b';') => return Ok(Line::Comment),
-            Some(b'(') => return self.parenthesised(None).map(|s| Line::Step(PlanFormat::SasPlan, s)),
+            Some(b'(') => {
+                return self
+                    .parenthesised(None)
+                    .map(|s| Line::Step(PlanFormat::SasPlan, s))
+            }
             _ => {}
         }
         let save = self.pos;
@@ -199,13 +206,19 @@ impl<'a> LineReader<'a> {
                 if !head.starts_with(['+', '-']) && time.is_finite() {
                     self.skip_ws();
                     if self.peek() == Some(b'(') {
-                        return self.parenthesised(Some(time)).map(|s| Line::Step(PlanFormat::Timed, s));
+                        return self
+                            .parenthesised(Some(time))
+                            .map(|s| Line::Step(PlanFormat::Timed, s));
                     }
                     if *in_ff {
                         return self.bare().map(|s| Line::Step(PlanFormat::Ff, s));
                     }
                     return Err(self
-                        .error(wstart, self.text.len(), "expected `(action arg ...)` after the time")
+                        .error(
+                            wstart,
+                            self.text.len(),
+                            "expected `(action arg ...)` after the time",
+                        )
                         .with_hint("timed plans read `0.000: (action arg ...) [1.000]`"));
                 }
             }
@@ -247,7 +260,11 @@ impl<'a> LineReader<'a> {
         }
         if self.pos < self.text.len() {
             let at = self.pos;
-            return Err(self.error(at, at + 1, format!("unexpected `{}` in a plan step", &self.text[at..at + 1])));
+            return Err(self.error(
+                at,
+                at + 1,
+                format!("unexpected `{}` in a plan step", &self.text[at..at + 1]),
+            ));
         }
         if words.is_empty() {
             return Err(self.error(start, self.text.len(), "expected an action name"));
@@ -281,7 +298,11 @@ impl<'a> LineReader<'a> {
                     Some((s, w)) => words.push(self.name(s, w)?),
                     None => {
                         let at = self.pos;
-                        return Err(self.error(at, at + 1, format!("unexpected `{}` in a plan step", &self.text[at..at + 1])));
+                        return Err(self.error(
+                            at,
+                            at + 1,
+                            format!("unexpected `{}` in a plan step", &self.text[at..at + 1]),
+                        ));
                     }
                 },
             }
@@ -300,7 +321,9 @@ impl<'a> LineReader<'a> {
         if let Some(b) = self.peek() {
             if b != b';' {
                 let at = self.pos;
-                return Err(self.error(at, self.text.len(), "unexpected text after the step").with_hint("a step may be followed only by `[DURATION]` and a `;` comment"));
+                return Err(self
+                    .error(at, self.text.len(), "unexpected text after the step")
+                    .with_hint("a step may be followed only by `[DURATION]` and a `;` comment"));
             }
         }
         let action = words.remove(0);
@@ -328,17 +351,24 @@ impl<'a> LineReader<'a> {
             .find_map(|part| part.strip_prefix("D:").or_else(|| part.strip_prefix("d:")))
             .unwrap_or(inner)
             .trim();
-        value.parse::<f64>().ok().filter(|d| d.is_finite() && *d >= 0.0).ok_or_else(|| {
-            self.error(open, open + len + 1, format!("`{inner}` is not a duration"))
-                .with_hint("durations read `[1.000]` (or LPG's `[D:1.00; C:3.00]`)")
-        })
+        value
+            .parse::<f64>()
+            .ok()
+            .filter(|d| d.is_finite() && *d >= 0.0)
+            .ok_or_else(|| {
+                self.error(open, open + len + 1, format!("`{inner}` is not a duration"))
+                    .with_hint("durations read `[1.000]` (or LPG's `[D:1.00; C:3.00]`)")
+            })
     }
 }
 
 /// `; cost = 4 (unit cost)` as Fast Downward writes it.
 fn stated_cost(line: &str, base: usize, file: FileId) -> Option<StatedCost> {
     let start = line.find("cost")?;
-    let rest = line[start + 4..].trim_start().strip_prefix('=')?.trim_start();
+    let rest = line[start + 4..]
+        .trim_start()
+        .strip_prefix('=')?
+        .trim_start();
     let end = rest.find(|c: char| c.is_whitespace()).unwrap_or(rest.len());
     let value = rest[..end].parse::<f64>().ok()?;
     Some(StatedCost {
@@ -370,7 +400,10 @@ mod tests {
 
     #[test]
     fn reads_sas_plan_and_cost() {
-        let (plan, diags) = parse_plan("(pick ball1 rooma left)\r\n(wait )\n; cost = 4 (unit cost)\n", 0);
+        let (plan, diags) = parse_plan(
+            "(pick ball1 rooma left)\r\n(wait )\n; cost = 4 (unit cost)\n",
+            0,
+        );
         assert!(diags.is_empty());
         assert_eq!(plan.format, PlanFormat::SasPlan);
         assert_eq!(plan.steps.len(), 2);
@@ -385,7 +418,13 @@ mod tests {
         let (format, s, diags) = steps(text);
         assert!(diags.is_empty(), "{diags:?}");
         assert_eq!(format, PlanFormat::Bare);
-        assert_eq!(s, vec!["move floor_robot curr_position bin1", "grasp floor_robot battery_red bin1"]);
+        assert_eq!(
+            s,
+            vec![
+                "move floor_robot curr_position bin1",
+                "grasp floor_robot battery_red bin1"
+            ]
+        );
     }
 
     #[test]

@@ -49,17 +49,27 @@ fn type_step(
         let d = Diagnostic::error(
             codes::PLAN_UNKNOWN_ACTION,
             step.action.span,
-            format!("step {}: the domain has no action `{}`", i + 1, step.action.name),
+            format!(
+                "step {}: the domain has no action `{}`",
+                i + 1,
+                step.action.name
+            ),
         );
-        diags.push(match did_you_mean(&step.action.name, dix.actions.keys().map(String::as_str)) {
-            Some(h) => d.with_hint(h),
-            None => d.with_hint("is this plan for another domain?"),
-        });
+        diags.push(
+            match did_you_mean(&step.action.name, dix.actions.keys().map(String::as_str)) {
+                Some(h) => d.with_hint(h),
+                None => d.with_hint("is this plan for another domain?"),
+            },
+        );
         return None;
     };
     let action = &domain.actions[sig.index];
     if step.args.len() != sig.params.len() {
-        let params: Vec<String> = action.params.iter().map(|p| format!("?{} - {}", p.name.name, p.ty)).collect();
+        let params: Vec<String> = action
+            .params
+            .iter()
+            .map(|p| format!("?{} - {}", p.name.name, p.ty))
+            .collect();
         diags.push(
             Diagnostic::error(
                 codes::PLAN_ARITY,
@@ -73,7 +83,10 @@ fn type_step(
                     step.args.len()
                 ),
             )
-            .with_label(action.name.span, format!("`{}` is declared here", step.action.name))
+            .with_label(
+                action.name.span,
+                format!("`{}` is declared here", step.action.name),
+            )
             .with_hint(format!("its parameters are ({})", params.join(" "))),
         );
         return None;
@@ -85,12 +98,18 @@ fn type_step(
             let d = Diagnostic::error(
                 codes::PLAN_UNKNOWN_OBJECT,
                 arg.span,
-                format!("step {}: `{}` is not an object of the problem or a constant of the domain", i + 1, arg.name),
+                format!(
+                    "step {}: `{}` is not an object of the problem or a constant of the domain",
+                    i + 1,
+                    arg.name
+                ),
             );
-            diags.push(match did_you_mean(&arg.name, pix.object_names.iter().map(String::as_str)) {
-                Some(h) => d.with_hint(h),
-                None => d.with_hint("is this plan for another problem?"),
-            });
+            diags.push(
+                match did_you_mean(&arg.name, pix.object_names.iter().map(String::as_str)) {
+                    Some(h) => d.with_hint(h),
+                    None => d.with_hint("is this plan for another problem?"),
+                },
+            );
             ok = false;
             continue;
         };

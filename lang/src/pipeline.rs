@@ -1,0 +1,110 @@
+//! The front end's stages bundled per file: parse + check a domain, a
+//! problem against it, a plan against both. Pure functions over texts held
+//! in [`Sources`]; the CLI, the tests and the incremental database call these.
+
+use crate::diagnostic::{has_errors, Diagnostic};
+use crate::pddl::{self, ast::Domain, ast::Problem, DomainIndex, ProblemIndex};
+use crate::plan::{self, GroundStep, Plan};
+use crate::source::{FileId, Sources};
+use crate::state::World;
+use crate::validate::{validate, Validation};
+
+pub struct DomainUnit {
+    pub file: FileId,
+    pub domain: Option<Domain>,
+    pub index: DomainIndex,
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+pub struct ProblemUnit {
+    pub file: FileId,
+    pub problem: Option<Problem>,
+    pub index: ProblemIndex,
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+pub struct PlanUnit {
+    pub file: FileId,
+    pub plan: Plan,
+    pub steps: Vec<GroundStep>,
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+pub fn domain_unit(sources: &Sources, file: FileId) -> DomainUnit {
+    let (domain, mut diagnostics) = pddl::parse_domain(sources.text(file), file);
+    let index = match &domain {
+        Some(d) => {
+            let (index, diags) = pddl::check_domain(d);
+            diagnostics.extend(diags);
+            index
+        }
+        None => DomainIndex::default(),
+    };
+    DomainUnit {
+        file,
+        domain,
+        index,
+        diagnostics,
+    }
+}
+
+pub fn problem_unit(sources: &Sources, file: FileId, domain: &DomainUnit) -> ProblemUnit {
+    let (problem, mut diagnostics) = pddl::parse_problem(sources.text(file), file);
+    let index = match (&problem, &domain.domain) {
+        (Some(p), Some(d)) => {
+            let (index, diags) = pddl::check_problem(p, d, &domain.index);
+            diagnostics.extend(diags);
+            index
+        }
+        _ => ProblemIndex::default(),
+    };
+    ProblemUnit {
+        file,
+        problem,
+        index,
+        diagnostics,
+    }
+}
+
+pub fn plan_unit(
+    sources: &Sources,
+    file: FileId,
+    domain: &DomainUnit,
+    problem: &ProblemUnit,
+) -> PlanUnit {
+    let (plan, mut diagnostics) = plan::parse_plan(sources.text(file), file);
+    let mut steps = Vec::new();
+    if let Some(d) = &domain.domain {
+        let (s, diags) = plan::type_plan(&plan, d, &domain.index, &problem.index);
+        steps = s;
+        diagnostics.extend(diags);
+    }
+    PlanUnit {
+        file,
+        plan,
+        steps,
+        diagnostics,
+    }
+}
+
+/// Validates a plan when every stage before it is free of errors; `None`
+/// otherwise (their diagnostics say why).
+pub fn validate_units(
+    domain: &DomainUnit,
+    problem: &ProblemUnit,
+    plan: &PlanUnit,
+) -> Option<Validation> {
+    if has_errors(&domain.diagnostics)
+        || has_errors(&problem.diagnostics)
+        || has_errors(&plan.diagnostics)
+    {
+        return None;
+    }
+    let world = World::new(domain.domain.as_ref()?, &domain.index, &problem.index);
+    Some(validate(
+        &world,
+        problem.problem.as_ref()?,
+        &plan.plan,
+        &plan.steps,
+    ))
+}
