@@ -37,7 +37,11 @@ fn write_report(d: &Diagnostic, sources: &Sources, color: bool, out: &mut Vec<u8
         )
         .with_code(d.code)
         .with_message(&d.message)
-        .with_label(Label::new(primary).with_message(&d.message).with_color(c));
+        .with_label(
+            Label::new(primary)
+                .with_message(code_title(d.code))
+                .with_color(c),
+        );
     for l in &d.labels {
         report = report.with_label(
             Label::new(ariadne_span(sources, l.span))
@@ -60,6 +64,14 @@ fn write_report(d: &Diagnostic, sources: &Sources, color: bool, out: &mut Vec<u8
     );
     // Writing into a Vec cannot fail.
     let _ = report.finish().write(cache, &mut *out);
+}
+
+/// The title of a code, shown under the primary span.
+pub fn code_title(code: &str) -> &'static str {
+    crate::diagnostic::codes::ALL
+        .iter()
+        .find(|c| c.id == code)
+        .map_or("here", |c| c.title)
 }
 
 /// A position for JSON consumers: 1-based line, 1-based character column.

@@ -5,6 +5,7 @@
 use crate::pddl::ast::*;
 use crate::pddl::check::{DomainIndex, ProblemIndex};
 use crate::pddl::types::TypeId;
+use crate::source::Span;
 use rustc_hash::{FxHashMap, FxHashSet};
 use std::cell::RefCell;
 
@@ -256,15 +257,16 @@ impl<'a> World<'a> {
     }
 
     /// Why a formula that does not hold fails, in the user's terms: the
-    /// first failing literal with its arguments filled in.
+    /// first failing literal with its arguments filled in, and its span.
     pub fn why_not<'e>(
         &self,
         s: &State,
         f: &'e Formula,
         env: &mut Env<'e>,
         duration: Option<f64>,
-    ) -> String {
-        match f {
+    ) -> (String, Span) {
+        let span = f.span();
+        let text = match f {
             Formula::Atom { atom } => format!("`{}` is false", self.show_ground(atom, env)),
             Formula::Equal { left, right, .. } => format!(
                 "`{}` and `{}` are different objects",
@@ -283,40 +285,39 @@ impl<'a> World<'a> {
                 ),
                 _ => "a negated condition holds".to_owned(),
             },
-            Formula::And { parts, .. } => parts
-                .iter()
-                .find(|p| !self.holds(s, p, env, duration))
-                .map(|p| self.why_not(s, p, env, duration))
-                .unwrap_or_default(),
+            Formula::And { parts, .. } => {
+                return match parts.iter().find(|p| !self.holds(s, p, env, duration)) {
+                    Some(p) => self.why_not(s, p, env, duration),
+                    None => (String::new(), span),
+                }
+            }
             Formula::Or { .. } => "none of the alternatives of an `or` holds".to_owned(),
             Formula::Imply { right, .. } => {
-                format!(
-                    "the condition of an `imply` holds, but {}",
-                    self.why_not(s, right, env, duration)
-                )
+                let (why, _) = self.why_not(s, right, env, duration);
+                format!("the condition of an `imply` holds, but {why}")
             }
             Formula::Exists { vars, .. } => {
                 let vs: Vec<String> = vars.iter().map(|v| format!("?{}", v.name.name)).collect();
                 format!("no choice of {} satisfies an `exists`", vs.join(" "))
             }
-            Formula::Forall { vars, body, .. } => self
-                .each_binding(vars, env, &mut |env| {
-                    if self.holds(s, body, env, duration) {
-                        return None;
-                    }
-                    let bound: Vec<String> = env[env.len() - vars.len()..]
-                        .iter()
-                        .map(|(v, o)| format!("?{v} = {}", self.pix.object_names[*o as usize]))
-                        .collect();
-                    Some(format!(
-                        "for {}: {}",
-                        bound.join(", "),
-                        self.why_not(s, body, env, duration)
-                    ))
-                })
-                .unwrap_or_default(),
+            Formula::Forall { vars, body, .. } => {
+                return self
+                    .each_binding(vars, env, &mut |env| {
+                        if self.holds(s, body, env, duration) {
+                            return None;
+                        }
+                        let bound: Vec<String> = env[env.len() - vars.len()..]
+                            .iter()
+                            .map(|(v, o)| format!("?{v} = {}", self.pix.object_names[*o as usize]))
+                            .collect();
+                        let (why, at) = self.why_not(s, body, env, duration);
+                        Some((format!("for {}: {why}", bound.join(", ")), at))
+                    })
+                    .unwrap_or((String::new(), span))
+            }
             Formula::Compare { .. } => "a numeric comparison does not hold".to_owned(),
-        }
+        };
+        (text, span)
     }
 
     fn show_term(&self, t: &Term, env: &Env) -> String {

@@ -2,7 +2,7 @@
 //! the first step whose precondition fails, or the goal literals it misses.
 
 use crate::diagnostic::{codes, Diagnostic};
-use crate::pddl::ast::{Action, Domain, Formula, Problem};
+use crate::pddl::ast::{Action, Domain, Effect, Formula, Problem};
 use crate::plan::{GroundStep, Plan};
 use crate::state::{Changes, Env, State, World};
 use serde::Serialize;
@@ -102,7 +102,7 @@ fn missing_goals(world: &World, state: &State, goal: &Formula) -> Vec<String> {
             .flat_map(|p| missing_goals(world, state, p))
             .collect(),
         g if !world.holds(state, g, &mut env, None) => {
-            vec![world.why_not(state, g, &mut env, None)]
+            vec![world.why_not(state, g, &mut env, None).0]
         }
         _ => Vec::new(),
     }
@@ -146,15 +146,7 @@ pub fn apply_step(
     };
     ctx.check(state, &action.pre_start, &mut env, start_phase)?;
     if action.durative {
-        apply_effects(
-            world,
-            state,
-            &action.eff_start,
-            &mut env,
-            duration,
-            g,
-            action,
-        )?;
+        ctx.apply_effects(state, &action.eff_start, &mut env)?;
         ctx.check(
             state,
             &action.pre_over_all,
@@ -163,7 +155,7 @@ pub fn apply_step(
         )?;
         ctx.check(state, &action.pre_end, &mut env, "its `at end` condition")?;
     }
-    apply_effects(world, state, &action.eff_end, &mut env, duration, g, action)
+    ctx.apply_effects(state, &action.eff_end, &mut env)
 }
 
 struct StepCtx<'w, 'a> {
@@ -185,7 +177,7 @@ impl<'a> StepCtx<'_, 'a> {
         let (world, g) = (self.world, self.g);
         for c in conds {
             if !world.holds(state, c, env, self.duration) {
-                let why = world.why_not(state, c, env, self.duration);
+                let (why, at) = world.why_not(state, c, env, self.duration);
                 return Err(Diagnostic::error(
                     codes::PRECONDITION_FAILS,
                     self.plan.steps[g.step].span,
@@ -195,43 +187,42 @@ impl<'a> StepCtx<'_, 'a> {
                         show_step(world, self.action, g)
                     ),
                 )
-                .with_label(c.span(), "this condition fails"));
+                .with_label(at, "this condition fails"));
             }
         }
         Ok(())
     }
-}
 
-fn apply_effects<'a>(
-    world: &World,
-    state: &mut State,
-    effects: &'a [crate::pddl::ast::Effect],
-    env: &mut Env<'a>,
-    duration: Option<f64>,
-    g: &GroundStep,
-    action: &Action,
-) -> Result<(), Diagnostic> {
-    let mut changes = Changes::default();
-    for e in effects {
-        world.collect_effect(state, e, env, duration, &mut changes);
+    fn apply_effects(
+        &self,
+        state: &mut State,
+        effects: &'a [Effect],
+        env: &mut Env<'a>,
+    ) -> Result<(), Diagnostic> {
+        let (world, g) = (self.world, self.g);
+        let mut changes = Changes::default();
+        for e in effects {
+            world.collect_effect(state, e, env, self.duration, &mut changes);
+        }
+        if let Some(err) = changes.numeric_errors.first() {
+            return Err(Diagnostic::error(
+                codes::EFFECT_CONFLICT,
+                self.plan.steps[g.step].span,
+                format!(
+                    "step {} `{}`: `{}` has no value to update",
+                    g.step + 1,
+                    show_step(world, self.action, g),
+                    err.fluent
+                ),
+            )
+            .with_label(self.action.name.span, "the action that updates it")
+            .with_hint(
+                "give the function a value in the problem's `:init`, e.g. `(= (total-cost) 0)`",
+            ));
+        }
+        world.apply(state, changes);
+        Ok(())
     }
-    if let Some(err) = changes.numeric_errors.first() {
-        return Err(Diagnostic::error(
-            codes::EFFECT_CONFLICT,
-            action.name.span,
-            format!(
-                "step {} `{}`: `{}` has no value to update",
-                g.step + 1,
-                show_step(world, action, g),
-                err.fluent
-            ),
-        )
-        .with_hint(
-            "give the function a value in the problem's `:init`, e.g. `(= (total-cost) 0)`",
-        ));
-    }
-    world.apply(state, changes);
-    Ok(())
 }
 
 pub fn show_step(world: &World, action: &Action, g: &GroundStep) -> String {

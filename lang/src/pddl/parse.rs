@@ -135,6 +135,8 @@ impl Parser {
 
     fn expected(&mut self, what: &str, found: Option<&Sexp>, missing_at: Span) {
         match found {
+            // The lexer has reported this word already.
+            Some(s) if matches!(s.tok(), Some(Tok::Invalid(_))) => {}
             Some(s) => {
                 let msg = format!("expected {what}, found {}", s.describe());
                 self.error(codes::EXPECTED, s.span(), msg);

@@ -90,6 +90,16 @@ pub fn parse_plan(text: &str, file: FileId) -> (Plan, Vec<Diagnostic>) {
             Err(d) => diags.push(d),
         }
     }
+    if plan.steps.is_empty() && diags.is_empty() {
+        diags.push(
+            Diagnostic::warning(
+                codes::PLAN_EMPTY,
+                Span::new(file, 0, 0),
+                "this plan has no steps",
+            )
+            .with_hint("plan steps look like `(action arg ...)`; is this the right file?"),
+        );
+    }
     if plan.steps.iter().any(|s| s.time.is_some()) {
         // Temporal planners do not always print in time order (LPG).
         plan.steps.sort_by(|a, b| {

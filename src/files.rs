@@ -1,0 +1,63 @@
+//! Reading input files into [`Sources`], with encoding problems reported as
+//! diagnostics rather than failures.
+
+use btc_lang::diagnostic::{codes, Diagnostic};
+use btc_lang::source::{decode, DecodeProblem, FileId, Sources, Span};
+use std::path::Path;
+
+/// Reads a file. `Err` only when it cannot be read at all.
+pub fn load(
+    sources: &mut Sources,
+    path: &Path,
+    diags: &mut Vec<Diagnostic>,
+) -> anyhow::Result<FileId> {
+    let len = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
+    if len > btc_lang::source::MAX_FILE_BYTES as u64 {
+        let id = sources.add(path.display().to_string(), String::new());
+        diags.push(too_large(id, len));
+        return Ok(id);
+    }
+    let bytes = std::fs::read(path).map_err(|e| {
+        anyhow::anyhow!(
+            "[{}] cannot read `{}`: {e}",
+            codes::FILE_UNREADABLE.id,
+            path.display()
+        )
+    })?;
+    let (text, problem) = decode(&bytes);
+    let id = sources.add(path.display().to_string(), text);
+    match problem {
+        None => {}
+        Some(DecodeProblem::InvalidUtf8 { offset, byte }) => diags.push(
+            Diagnostic::error(
+                codes::FILE_ENCODING,
+                Span::new(id, offset, offset + 3),
+                format!(
+                    "this file is not UTF-8: byte 0x{byte:02X} at offset {offset} is not valid"
+                ),
+            )
+            .with_hint("save the file as UTF-8; btc read the rest with the bad bytes replaced"),
+        ),
+        Some(DecodeProblem::BadUtf16) => diags.push(
+            Diagnostic::error(
+                codes::FILE_ENCODING,
+                Span::new(id, 0, 0),
+                "this file starts with a UTF-16 byte-order mark but is not valid UTF-16",
+            )
+            .with_hint("save the file as UTF-8"),
+        ),
+        Some(DecodeProblem::TooLarge { bytes }) => diags.push(too_large(id, bytes as u64)),
+    }
+    Ok(id)
+}
+
+fn too_large(id: FileId, bytes: u64) -> Diagnostic {
+    Diagnostic::error(
+        codes::FILE_TOO_LARGE,
+        Span::new(id, 0, 0),
+        format!(
+            "this file has {bytes} bytes; btc reads files of at most {} bytes",
+            btc_lang::source::MAX_FILE_BYTES
+        ),
+    )
+}

@@ -1,0 +1,143 @@
+//! `btc pddl FILE...`: parse and check domains and problems.
+
+use crate::{files, report, Format};
+use btc_lang::diagnostic::{codes, Diagnostic};
+use btc_lang::pddl::{self, Document};
+use btc_lang::pipeline::{domain_unit, problem_unit, DomainUnit};
+use btc_lang::source::Sources;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+pub fn run(
+    paths: &[PathBuf],
+    domain: Option<&Path>,
+    json: bool,
+    format: Format,
+) -> anyhow::Result<ExitCode> {
+    let mut sources = Sources::new();
+    let mut all_diags: Vec<Diagnostic> = Vec::new();
+    let mut models = Vec::new();
+    let mut summaries = Vec::new();
+    let mut explicit: Option<DomainUnit> = None;
+    if let Some(path) = domain {
+        let id = files::load(&mut sources, path, &mut all_diags)?;
+        let unit = domain_unit(&sources, id);
+        all_diags.extend(unit.diagnostics.iter().cloned());
+        explicit = Some(unit);
+    }
+    for path in paths {
+        let mut diags = Vec::new();
+        let id = files::load(&mut sources, path, &mut diags)?;
+        let (doc, _) = pddl::parse_document(sources.text(id), id);
+        let summary = match doc {
+            Some(Document::Domain(_)) | None => {
+                let unit = domain_unit(&sources, id);
+                diags.extend(unit.diagnostics.iter().cloned());
+                if let Some(d) = &unit.domain {
+                    models.push(serde_json::json!({ "file": path, "kind": "domain", "model": d }));
+                    format!(
+                        "domain {}: {}, {}, {}",
+                        d.name.name,
+                        report::plural(d.types.len(), "type"),
+                        report::plural(d.predicates.len(), "predicate"),
+                        report::plural(d.actions.len(), "action")
+                    )
+                } else {
+                    "not a PDDL domain or problem".to_owned()
+                }
+            }
+            Some(Document::Problem(p)) => {
+                let found;
+                let du = match &explicit {
+                    Some(u) => Some(u),
+                    None => match find_domain(path, &p.domain.name) {
+                        Some(dpath) => {
+                            let did = files::load(&mut sources, &dpath, &mut diags)?;
+                            let u = domain_unit(&sources, did);
+                            diags.extend(u.diagnostics.iter().filter(|d| d.is_error()).cloned());
+                            found = u;
+                            Some(&found)
+                        }
+                        None => None,
+                    },
+                };
+                match du {
+                    Some(du) => {
+                        let pu = problem_unit(&sources, id, du);
+                        diags.extend(pu.diagnostics.iter().cloned());
+                    }
+                    None => {
+                        diags.extend(pddl::parse_problem(sources.text(id), id).1);
+                        diags.push(
+                            Diagnostic::error(codes::DOMAIN_MISMATCH, p.domain.span, format!("cannot find domain `{}` to check this problem against", p.domain.name))
+                                .with_hint("pass it with `--domain FILE`, or put it beside the problem as `domain.pddl`"),
+                        );
+                    }
+                }
+                models.push(serde_json::json!({ "file": path, "kind": "problem", "model": p }));
+                format!(
+                    "problem {} (domain {}): {}, {}",
+                    p.name.name,
+                    p.domain.name,
+                    report::plural(p.objects.len(), "object"),
+                    report::plural(p.init.len(), "initial fact")
+                )
+            }
+        };
+        let (e, w) = report::count(&diags);
+        summaries.push(format!(
+            "{}: {summary}; {}, {}",
+            path.display(),
+            report::plural(e, "error"),
+            report::plural(w, "warning")
+        ));
+        all_diags.extend(diags);
+    }
+    let diag_json = report::diagnostics(&all_diags, &sources, format);
+    let failed = all_diags.iter().any(Diagnostic::is_error);
+    if json || format == Format::Json {
+        let doc = serde_json::json!({
+            "ok": !failed,
+            "files": if json { serde_json::Value::Array(models) } else { serde_json::Value::Null },
+            "summaries": summaries,
+            "diagnostics": diag_json,
+        });
+        println!("{}", serde_json::to_string_pretty(&doc)?);
+    } else {
+        for s in summaries {
+            println!("{s}");
+        }
+    }
+    Ok(if failed {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
+    })
+}
+
+/// The domain of a problem: `domain.pddl` or `NAME-domain.pddl` beside it,
+/// or any `.pddl` file there that defines the named domain.
+fn find_domain(problem: &Path, name: &str) -> Option<PathBuf> {
+    let dir = problem
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let stem = problem.file_stem()?.to_string_lossy();
+    for candidate in [
+        dir.join(format!("{stem}-domain.pddl")),
+        dir.join("domain.pddl"),
+    ] {
+        if candidate.is_file() {
+            return Some(candidate);
+        }
+    }
+    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
+        .ok()?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .collect();
+    entries.sort();
+    entries.into_iter().find(|p| {
+        p.extension().is_some_and(|e| e.eq_ignore_ascii_case("pddl"))
+            && std::fs::read_to_string(p).is_ok_and(|t| matches!(pddl::parse_document(&t, 0).0, Some(Document::Domain(d)) if d.name.name == name))
+    })
+}

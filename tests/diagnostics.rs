@@ -1,0 +1,67 @@
+//! One fixture per diagnostic code: `tests/fixtures/diagnostics/CODE/` holds
+//! the inputs and a `cmd` file with the `btc` arguments. Each run must report
+//! its code; the whole output is snapshotted.
+
+use std::path::Path;
+use std::process::Command;
+
+fn run_fixture(cmd_file: &Path) -> (String, i32) {
+    let dir = cmd_file.parent().unwrap();
+    let args = std::fs::read_to_string(cmd_file).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_btc"))
+        .args(args.split_whitespace())
+        .current_dir(dir)
+        .env("NO_COLOR", "1")
+        .output()
+        .unwrap();
+    let text = format!(
+        "$ btc {}\nexit: {}\n--- stdout\n{}--- stderr\n{}",
+        args.trim(),
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    (text, out.status.code().unwrap_or(-1))
+}
+
+#[test]
+fn every_fixture_reports_its_code() {
+    insta::glob!("fixtures/diagnostics/*/cmd", |path| {
+        let code = path
+            .parent()
+            .unwrap()
+            .file_name()
+            .unwrap()
+            .to_str()
+            .unwrap();
+        let (out, exit) = run_fixture(path);
+        assert!(
+            out.contains(&format!("[{code}]")),
+            "fixture {code} did not report {code}:\n{out}"
+        );
+        assert!(exit != 101, "btc panicked on fixture {code}");
+        insta::assert_snapshot!(out);
+    });
+}
+
+/// Codes that no file-sized fixture can trigger, with where they are tested.
+const NO_FIXTURE: &[(&str, &str)] = &[(
+    "F003",
+    "a file over 1 GiB: files::load checks the size first",
+)];
+
+#[test]
+fn every_code_has_a_fixture() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/diagnostics");
+    for code in btc_lang::diagnostic::codes::ALL {
+        if NO_FIXTURE.iter().any(|(c, _)| *c == code.id) {
+            continue;
+        }
+        assert!(
+            root.join(code.id).join("cmd").is_file(),
+            "no fixture for {} ({})",
+            code.id,
+            code.title
+        );
+    }
+}
