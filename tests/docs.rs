@@ -3,7 +3,8 @@
 
 #[test]
 fn diagnostic_reference_matches_the_code_list() {
-    let doc = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/diagnostics.md")).unwrap();
+    let doc = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/diagnostics.md"))
+        .unwrap();
     let rows: Vec<(String, String)> = doc
         .lines()
         .filter_map(|l| {

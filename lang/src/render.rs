@@ -8,9 +8,22 @@ use serde::Serialize;
 
 /// Renders diagnostics as ariadne reports into a string.
 pub fn to_terminal(diags: &[Diagnostic], sources: &Sources, color: bool) -> String {
+    // One cache for all reports: building ariadne's line index copies the
+    // file, so doing it per diagnostic would be quadratic.
+    let mut files: Vec<FileId> = diags
+        .iter()
+        .flat_map(|d| std::iter::once(d.span.file).chain(d.labels.iter().map(|l| l.span.file)))
+        .collect();
+    files.sort_unstable();
+    files.dedup();
+    let mut cache = ariadne::sources(
+        files
+            .into_iter()
+            .map(|f| (sources.get(f).path.clone(), sources.text(f).to_owned())),
+    );
     let mut out = Vec::new();
     for d in diags {
-        write_report(d, sources, color, &mut out);
+        write_report(d, sources, color, &mut cache, &mut out);
     }
     String::from_utf8_lossy(&out).into_owned()
 }
@@ -23,7 +36,13 @@ fn ariadne_span(sources: &Sources, span: Span) -> (String, std::ops::Range<usize
     (sources.get(span.file).path.clone(), start..end)
 }
 
-fn write_report(d: &Diagnostic, sources: &Sources, color: bool, out: &mut Vec<u8>) {
+fn write_report(
+    d: &Diagnostic,
+    sources: &Sources,
+    color: bool,
+    cache: &mut impl ariadne::Cache<String>,
+    out: &mut Vec<u8>,
+) {
     let (kind, c) = match d.severity {
         Severity::Error => (ReportKind::Error, Color::Red),
         Severity::Warning => (ReportKind::Warning, Color::Yellow),
@@ -52,18 +71,8 @@ fn write_report(d: &Diagnostic, sources: &Sources, color: bool, out: &mut Vec<u8
     if let Some(h) = &d.hint {
         report = report.with_help(h);
     }
-    let mut files: Vec<FileId> = std::iter::once(d.span.file)
-        .chain(d.labels.iter().map(|l| l.span.file))
-        .collect();
-    files.sort_unstable();
-    files.dedup();
-    let cache = ariadne::sources(
-        files
-            .into_iter()
-            .map(|f| (sources.get(f).path.clone(), sources.text(f).to_owned())),
-    );
     // Writing into a Vec cannot fail.
-    let _ = report.finish().write(cache, &mut *out);
+    let _ = report.finish().write(&mut *cache, &mut *out);
 }
 
 /// The title of a code, shown under the primary span.

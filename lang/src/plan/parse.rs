@@ -196,7 +196,16 @@ impl<'a> LineReader<'a> {
             _ => {}
         }
         let save = self.pos;
-        let (wstart, first) = self.word().expect("not at a delimiter");
+        let Some((wstart, first)) = self.word() else {
+            // `)`, `[` or `]` where a step should start.
+            let at = self.pos;
+            let c = &self.text[at..at + 1];
+            return Err(self.error(
+                at,
+                at + 1,
+                format!("unexpected `{c}` at the start of a plan line"),
+            ));
+        };
         // `step 0: NAME ARGS` (FF)
         if first.eq_ignore_ascii_case("step") {
             self.skip_ws();
