@@ -137,7 +137,7 @@ pub fn decode(bytes: &[u8]) -> (String, Option<DecodeProblem>) {
         return decode_utf8(rest);
     }
     let utf16 = |rest: &[u8], le: bool| {
-        if rest.len() % 2 != 0 {
+        if !rest.len().is_multiple_of(2) {
             return (String::new(), Some(DecodeProblem::BadUtf16));
         }
         let units = rest.chunks_exact(2).map(|c| {

@@ -216,14 +216,6 @@ impl Feature {
     }
 }
 
-/// Where a formula stands; decides what may appear in it.
-#[derive(Clone, Copy, PartialEq, Eq)]
-enum Place {
-    Condition,
-    Goal,
-    Derived,
-}
-
 struct Checker<'a> {
     domain: &'a Domain,
     index: &'a DomainIndex,
@@ -363,7 +355,7 @@ pub fn check_domain(domain: &Domain) -> (DomainIndex, Vec<Diagnostic>) {
         let scope = scope_of(&a.params, &index.types);
         check_duplicate_vars(&a.params, &mut c.diags);
         for f in a.pre_start.iter().chain(&a.pre_over_all).chain(&a.pre_end) {
-            c.formula(f, &scope, Place::Condition);
+            c.formula(f, &scope);
         }
         for e in a.eff_start.iter().chain(&a.eff_end) {
             c.effect(e, &scope);
@@ -376,7 +368,7 @@ pub fn check_domain(domain: &Domain) -> (DomainIndex, Vec<Diagnostic>) {
     for d in &domain.derived {
         let scope = scope_of(&d.head.params, &index.types);
         check_duplicate_vars(&d.head.params, &mut c.diags);
-        c.formula(&d.body, &scope, Place::Derived);
+        c.formula(&d.body, &scope);
     }
     let used = std::mem::take(&mut c.used);
     diags.append(&mut c.diags);
@@ -477,7 +469,7 @@ pub fn check_problem(
         }
     }
     if let Some(g) = &problem.goal {
-        c.formula(g, &scope, Place::Goal);
+        c.formula(g, &scope);
     }
     if let Some(m) = &problem.metric {
         c.num_expr(&m.expr, &scope);
@@ -786,7 +778,7 @@ impl Checker<'_> {
         inner
     }
 
-    fn formula(&mut self, f: &Formula, scope: &Scope, place: Place) {
+    fn formula(&mut self, f: &Formula, scope: &Scope) {
         match f {
             Formula::Atom { atom } => self.atom(atom, scope),
             Formula::Equal { left, right, span } => {
@@ -796,33 +788,33 @@ impl Checker<'_> {
             }
             Formula::Not { formula, span } => {
                 self.use_feature(Feature::Negation, *span);
-                self.formula(formula, scope, place);
+                self.formula(formula, scope);
             }
             Formula::And { parts, .. } => {
                 for p in parts {
-                    self.formula(p, scope, place);
+                    self.formula(p, scope);
                 }
             }
             Formula::Or { parts, span } => {
                 self.use_feature(Feature::Disjunction, *span);
                 for p in parts {
-                    self.formula(p, scope, place);
+                    self.formula(p, scope);
                 }
             }
             Formula::Imply { left, right, span } => {
                 self.use_feature(Feature::Disjunction, *span);
-                self.formula(left, scope, place);
-                self.formula(right, scope, place);
+                self.formula(left, scope);
+                self.formula(right, scope);
             }
             Formula::Exists { vars, body, span } => {
                 self.use_feature(Feature::Existential, *span);
                 let inner = self.quantified(vars, scope);
-                self.formula(body, &inner, place);
+                self.formula(body, &inner);
             }
             Formula::Forall { vars, body, span } => {
                 self.use_feature(Feature::Universal, *span);
                 let inner = self.quantified(vars, scope);
-                self.formula(body, &inner, place);
+                self.formula(body, &inner);
             }
             Formula::Compare { left, right, .. } => {
                 self.num_expr(left, scope);
@@ -865,7 +857,7 @@ impl Checker<'_> {
                 span,
             } => {
                 self.use_feature(Feature::ConditionalEffects, *span);
-                self.formula(condition, scope, Place::Condition);
+                self.formula(condition, scope);
                 self.effect(body, scope);
             }
             Effect::Numeric { fluent, value, .. } => {

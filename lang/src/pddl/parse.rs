@@ -8,6 +8,8 @@ use crate::diagnostic::{codes, Code, Diagnostic};
 use crate::source::{FileId, Span};
 use serde::Serialize;
 
+/// A parsed file: one per file, so the size difference does not matter.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(tag = "kind", rename_all = "lowercase")]
 pub enum Document {
