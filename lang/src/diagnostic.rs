@@ -164,5 +164,29 @@ pub mod codes {
         GOAL_NOT_REACHED = "V002", "a plan that does not reach the goal";
         COST_MISMATCH = "V003", "a plan whose stated cost differs from its computed cost";
         EFFECT_CONFLICT = "V004", "a numeric effect that cannot be computed";
+        // .btrules
+        R_SYNTAX = "R001", "text that is not `.btrules` syntax";
+        R_UNKNOWN_ACTION = "R002", "a rule for an action the domain does not have";
+        R_PARAM_COUNT = "R003", "a rule pattern whose parameter count does not fit the PDDL action";
+        R_PORT_TYPE = "R004", "a value whose type cannot flow into the port it is bound to";
+        R_EFFECT_DIFFERS = "R005", "a rule effect that disagrees with the PDDL action's effect";
+        R_UNBOUND = "R006", "a variable or capture that the rule does not bind";
+        R_UNKNOWN_NODE = "R007", "a call to a node or tree that is not declared";
+        R_UNKNOWN_PORT = "R008", "a port the node does not declare";
+        R_UNKNOWN_TABLE = "R009", "a lookup in a table that is not declared";
+        R_MISSING_PORT = "R010", "a call that leaves a declared port out";
+        R_UNKNOWN_KEY = "R011", "a table lookup with a key the table does not have";
+        R_UNCOVERED = "R012", "a domain action that no rule covers";
+        R_SHADOWED = "R013", "a rule that an earlier rule always matches first";
+        R_UNUSED = "R014", "a declaration nothing uses";
+        R_NO_RULE = "R015", "a plan step that no rule matches";
+        R_STEP_TYPE = "R016", "a plan step whose argument types do not fit the rule";
+        R_NO_DOMAIN = "R017", "a rules file without a usable `domain`";
+        R_IMPORT = "R018", "an import that cannot be found";
+        R_DUPLICATE = "R019", "a name declared twice";
+        R_UNKNOWN_OBJECT = "R020", "a string naming an object the domain or problem does not have";
+        R_UNKNOWN_TYPE = "R021", "a port type that is neither a PDDL type nor a basic type";
+        R_PLAN_BLOCK = "R022", "a `plan` block that is missing, repeated or has no `steps`";
+        R_BAD_ARGUMENT = "R023", "a control or decorator argument that makes no sense";
     }
 }

@@ -11,6 +11,7 @@ pub mod pddl;
 pub mod pipeline;
 pub mod plan;
 pub mod render;
+pub mod rules;
 pub mod source;
 pub mod state;
 pub mod validate;

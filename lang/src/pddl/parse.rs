@@ -1182,3 +1182,18 @@ const PROBLEM_SECTIONS: &[&str] = &[
     "goal",
     "metric",
 ];
+
+/// Reads a PDDL goal description from an s-expression (used for formulas
+/// written inside `.btrules` files).
+pub fn formula_of(s: &Sexp) -> (Option<Formula>, Vec<Diagnostic>) {
+    let mut p = Parser { diags: Vec::new() };
+    let f = p.formula(s);
+    (f, p.diags)
+}
+
+/// Reads a PDDL effect from an s-expression.
+pub fn effect_of(s: &Sexp) -> (Option<Effect>, Vec<Diagnostic>) {
+    let mut p = Parser { diags: Vec::new() };
+    let e = p.effect(s);
+    (e, p.diags)
+}

@@ -1,0 +1,9 @@
+//! The `.btrules` language: lexer, syntax tree, parser, formatter.
+
+pub mod ast;
+pub mod fmt;
+pub mod lexer;
+pub mod parse;
+
+pub use ast::*;
+pub use parse::{parse_rules, ParsedRules};

@@ -1,0 +1,441 @@
+//! The `.btrules` syntax tree. Every item's spans are relative to the item's
+//! own start (see [`ItemNode::offset`]), so editing one item leaves the
+//! others' trees equal — the incremental checker relies on that.
+
+use crate::pddl::ast::{Effect, Formula};
+use crate::source::Span;
+use serde::Serialize;
+
+/// A name as written (case kept: node names are CamelCase).
+#[derive(Clone, Debug, PartialEq, Eq, Hash, Serialize)]
+pub struct Ident {
+    pub text: String,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum StrPart {
+    Text {
+        text: String,
+    },
+    /// `{?var}`
+    Var {
+        name: Ident,
+    },
+    /// `{capture}`
+    Capture {
+        name: Ident,
+    },
+}
+
+/// A string literal, split at its `{...}` interpolations.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct StrLit {
+    pub parts: Vec<StrPart>,
+    pub span: Span,
+}
+
+impl StrLit {
+    /// The text when the literal has no interpolation.
+    pub fn plain(&self) -> Option<String> {
+        let mut s = String::new();
+        for p in &self.parts {
+            match p {
+                StrPart::Text { text } => s.push_str(text),
+                _ => return None,
+            }
+        }
+        Some(s)
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum ImportTarget {
+    Path { path: StrLit },
+    Std { module: Ident },
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum NodeKind {
+    Action,
+    Condition,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct PortDecl {
+    pub out: bool,
+    pub name: Ident,
+    /// A PDDL type, or `string`, `int`, `float`, `bool`.
+    pub ty: Ident,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct NodeDecl {
+    pub kind: NodeKind,
+    pub name: Ident,
+    pub ports: Vec<PortDecl>,
+    /// `condition C(...) = (formula)`: evaluated on the KB by the runtime.
+    pub formula: Option<Formula>,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct TreeDecl {
+    pub name: Ident,
+    pub ports: Vec<PortDecl>,
+    pub body: Vec<Template>,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum Literal {
+    Int { value: i64, span: Span },
+    Float { value: f64, span: Span },
+    Str { value: StrLit },
+    Bool { value: bool, span: Span },
+    Name { name: Ident },
+}
+
+impl Literal {
+    pub fn span(&self) -> Span {
+        match self {
+            Literal::Int { span, .. }
+            | Literal::Float { span, .. }
+            | Literal::Bool { span, .. } => *span,
+            Literal::Str { value } => value.span,
+            Literal::Name { name } => name.span,
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct TableEntry {
+    pub key: Ident,
+    pub value: Literal,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct TableDecl {
+    pub name: Ident,
+    pub entries: Vec<TableEntry>,
+    pub span: Span,
+}
+
+/// One piece of a rule's action-name pattern: `PICK_{op}` is
+/// `[Lit("PICK_"), Capture("op")]`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum NamePart {
+    Lit { text: String, span: Span },
+    Capture { name: Ident },
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Param {
+    /// Variable name without `?`, lower-cased (PDDL is case-insensitive).
+    pub var: Ident,
+    /// `[?x]`: the step may omit it.
+    pub optional: bool,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Pattern {
+    pub name: Vec<NamePart>,
+    pub params: Vec<Param>,
+    pub span: Span,
+}
+
+impl Pattern {
+    /// The literal action name when the pattern has no capture.
+    pub fn literal_name(&self) -> Option<String> {
+        match self.name.as_slice() {
+            [NamePart::Lit { text, .. }] => Some(text.to_lowercase()),
+            _ => None,
+        }
+    }
+
+    pub fn name_span(&self) -> Span {
+        let first = self.name.first().map(part_span).unwrap_or(self.span);
+        let last = self.name.last().map(part_span).unwrap_or(self.span);
+        first.to(last)
+    }
+
+    /// The pattern as written, e.g. `PICK_{op}`.
+    pub fn name_text(&self) -> String {
+        self.name
+            .iter()
+            .map(|p| match p {
+                NamePart::Lit { text, .. } => text.clone(),
+                NamePart::Capture { name } => format!("{{{}}}", name.text),
+            })
+            .collect()
+    }
+}
+
+fn part_span(p: &NamePart) -> Span {
+    match p {
+        NamePart::Lit { span, .. } => *span,
+        NamePart::Capture { name } => name.span,
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "kebab-case")]
+pub enum Guard {
+    Ne {
+        left: Ident,
+        right: Ident,
+        span: Span,
+    },
+    Eq {
+        left: Ident,
+        right: Ident,
+        span: Span,
+    },
+    /// `?x - type`
+    IsType { var: Ident, ty: Ident, span: Span },
+    /// `capture in table`
+    InTable {
+        key: Ident,
+        table: Ident,
+        span: Span,
+    },
+}
+
+impl Guard {
+    pub fn span(&self) -> Span {
+        match self {
+            Guard::Ne { span, .. }
+            | Guard::Eq { span, .. }
+            | Guard::IsType { span, .. }
+            | Guard::InTable { span, .. } => *span,
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum RuleBody {
+    Skip {
+        span: Span,
+    },
+    Template {
+        body: Vec<Template>,
+        effect: Option<Effect>,
+    },
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Rule {
+    pub pattern: Pattern,
+    pub guards: Vec<Guard>,
+    pub body: RuleBody,
+    pub span: Span,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(tag = "kind", rename_all = "kebab-case")]
+pub enum ControlKind {
+    Sequence,
+    ReactiveSequence,
+    Fallback,
+    ReactiveFallback,
+    Parallel { success: u32, failure: u32 },
+}
+
+impl ControlKind {
+    pub fn keyword(self) -> &'static str {
+        match self {
+            ControlKind::Sequence => "sequence",
+            ControlKind::ReactiveSequence => "reactive_sequence",
+            ControlKind::Fallback => "fallback",
+            ControlKind::ReactiveFallback => "reactive_fallback",
+            ControlKind::Parallel { .. } => "parallel",
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(tag = "kind", rename_all = "kebab-case")]
+pub enum DecoratorKind {
+    Retry { times: u32 },
+    Repeat { times: u32 },
+    Timeout { ms: u64 },
+    Inverter,
+    ForceSuccess,
+    ForceFailure,
+}
+
+impl DecoratorKind {
+    pub fn keyword(self) -> &'static str {
+        match self {
+            DecoratorKind::Retry { .. } => "retry",
+            DecoratorKind::Repeat { .. } => "repeat",
+            DecoratorKind::Timeout { .. } => "timeout",
+            DecoratorKind::Inverter => "inverter",
+            DecoratorKind::ForceSuccess => "force_success",
+            DecoratorKind::ForceFailure => "force_failure",
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum StepsMode {
+    InOrder,
+    Parallel,
+    Backchained,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum Value {
+    Var {
+        name: Ident,
+    },
+    Str {
+        value: StrLit,
+    },
+    Int {
+        value: i64,
+        span: Span,
+    },
+    Float {
+        value: f64,
+        span: Span,
+    },
+    Bool {
+        value: bool,
+        span: Span,
+    },
+    /// `table[key]`: the key is a capture, a variable or a string.
+    Lookup {
+        table: Ident,
+        key: Box<Value>,
+        span: Span,
+    },
+    /// A bare name: a capture, or a table key.
+    Name {
+        name: Ident,
+    },
+}
+
+impl Value {
+    pub fn span(&self) -> Span {
+        match self {
+            Value::Var { name } | Value::Name { name } => name.span,
+            Value::Str { value } => value.span,
+            Value::Int { span, .. }
+            | Value::Float { span, .. }
+            | Value::Bool { span, .. }
+            | Value::Lookup { span, .. } => *span,
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Arg {
+    pub port: Ident,
+    pub value: Value,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum Template {
+    Control {
+        control: ControlKind,
+        name: Option<StrLit>,
+        children: Vec<Template>,
+        span: Span,
+    },
+    Decorator {
+        decorator: DecoratorKind,
+        name: Option<StrLit>,
+        child: Box<Template>,
+        span: Span,
+    },
+    Call {
+        name: Ident,
+        args: Vec<Arg>,
+        span: Span,
+    },
+    Steps {
+        mode: StepsMode,
+        span: Span,
+    },
+    /// Text that did not parse; reported already.
+    Error {
+        span: Span,
+    },
+}
+
+impl Template {
+    pub fn span(&self) -> Span {
+        match self {
+            Template::Control { span, .. }
+            | Template::Decorator { span, .. }
+            | Template::Call { span, .. }
+            | Template::Steps { span, .. }
+            | Template::Error { span } => *span,
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum Item {
+    Domain {
+        path: StrLit,
+        span: Span,
+    },
+    Problem {
+        path: StrLit,
+        span: Span,
+    },
+    Import {
+        target: ImportTarget,
+        span: Span,
+    },
+    Node(NodeDecl),
+    Tree(TreeDecl),
+    Table(TableDecl),
+    Rule(Rule),
+    Plan {
+        body: Vec<Template>,
+        span: Span,
+    },
+    /// An item that did not parse; its diagnostics are reported.
+    Error {
+        span: Span,
+    },
+}
+
+impl Item {
+    pub fn span(&self) -> Span {
+        match self {
+            Item::Domain { span, .. }
+            | Item::Problem { span, .. }
+            | Item::Import { span, .. }
+            | Item::Plan { span, .. }
+            | Item::Error { span } => *span,
+            Item::Node(n) => n.span,
+            Item::Tree(t) => t.span,
+            Item::Table(t) => t.span,
+            Item::Rule(r) => r.span,
+        }
+    }
+}
+
+/// A top-level item with its place in the file.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ItemNode {
+    /// Byte offset of the item's first token; the item's spans are relative to it.
+    pub offset: u32,
+    pub item: Item,
+}

@@ -1,0 +1,879 @@
+//! The `.btrules` parser. The token stream is first cut into top-level items
+//! (at item keywords outside brackets, or at the start of a line), and each
+//! item is parsed on its own with spans relative to its start: a broken item
+//! becomes [`Item::Error`] and the others still parse.
+
+use super::ast::*;
+use super::lexer::{lex, Comment, Tok};
+use crate::diagnostic::{codes, Diagnostic};
+use crate::pddl::lexer::{Tok as PTok, Token as PToken};
+use crate::pddl::parse::{effect_of, formula_of};
+use crate::pddl::sexpr;
+use crate::source::{FileId, Span};
+use chumsky::input::ValueInput;
+use chumsky::prelude::*;
+
+/// Deepest nesting of brackets inside one item.
+pub const MAX_ITEM_DEPTH: usize = 64;
+
+const ITEM_KEYWORDS: &[&str] = &[
+    "domain",
+    "problem",
+    "import",
+    "action",
+    "condition",
+    "tree",
+    "table",
+    "rule",
+    "plan",
+];
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParsedRules {
+    pub items: Vec<ItemNode>,
+    pub comments: Vec<Comment>,
+    /// Syntax diagnostics, with absolute spans.
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+pub fn parse_rules(text: &str, file: FileId) -> ParsedRules {
+    let lexed = lex(text, file);
+    let mut diagnostics = lexed.diagnostics;
+    let mut items = Vec::new();
+    for chunk in split_items(&lexed.tokens, text) {
+        let offset = lexed.tokens[chunk.start].1.start;
+        let (item, diags) = parse_item(&lexed.tokens[chunk], offset, file);
+        diagnostics.extend(diags.into_iter().map(|d| shift(d, file, offset)));
+        items.push(ItemNode { offset, item });
+    }
+    ParsedRules {
+        items,
+        comments: lexed.comments,
+        diagnostics,
+    }
+}
+
+/// Moves a diagnostic's spans in `file` by `offset` (from item-relative to
+/// absolute). Spans in other files (the PDDL domain) are absolute already.
+pub fn shift(mut d: Diagnostic, file: FileId, offset: u32) -> Diagnostic {
+    let mv = |s: &mut Span| {
+        if s.file == file {
+            s.start += offset;
+            s.end += offset;
+        }
+    };
+    mv(&mut d.span);
+    for l in &mut d.labels {
+        mv(&mut l.span);
+    }
+    d
+}
+
+fn at_line_start(text: &str, offset: u32) -> bool {
+    offset == 0 || text.as_bytes().get(offset as usize - 1) == Some(&b'\n')
+}
+
+fn split_items(tokens: &[(Tok, Span)], text: &str) -> Vec<std::ops::Range<usize>> {
+    let mut out = Vec::new();
+    let mut depth = 0usize;
+    let mut start = None;
+    for (i, (t, span)) in tokens.iter().enumerate() {
+        let is_kw = matches!(t, Tok::Ident(k) if ITEM_KEYWORDS.contains(&k.as_str()));
+        if is_kw && (depth == 0 || at_line_start(text, span.start)) {
+            if let Some(s) = start {
+                out.push(s..i);
+            }
+            start = Some(i);
+            depth = 0;
+        }
+        if start.is_none() {
+            start = Some(i); // text before the first keyword is an item of its own (an error)
+        }
+        match t {
+            Tok::Punct("(" | "{" | "[") => depth += 1,
+            Tok::Punct(")" | "}" | "]") => depth = depth.saturating_sub(1),
+            _ => {}
+        }
+    }
+    if let Some(s) = start {
+        out.push(s..tokens.len());
+    }
+    out
+}
+
+fn rel(span: Span, offset: u32) -> SimpleSpan {
+    SimpleSpan::from((span.start - offset) as usize..(span.end - offset) as usize)
+}
+
+/// Reads the PDDL group starting at `tokens[i]` (a `(`) with the PDDL
+/// front end; returns the replacement token and the index after the group.
+fn read_pddl_group(
+    tokens: &[(Tok, Span)],
+    i: usize,
+    offset: u32,
+    file: FileId,
+    effect: bool,
+    diags: &mut Vec<Diagnostic>,
+) -> ((Tok, SimpleSpan), usize) {
+    let mut depth = 0usize;
+    let mut j = i;
+    let mut ptoks = Vec::new();
+    while j < tokens.len() {
+        let (t, span) = &tokens[j];
+        let s = Span::new(
+            file,
+            (span.start - offset) as usize,
+            (span.end - offset) as usize,
+        );
+        let pt = match t {
+            Tok::Punct("(") => {
+                depth += 1;
+                PTok::LParen
+            }
+            Tok::Punct(")") => {
+                depth -= 1;
+                PTok::RParen
+            }
+            Tok::Ident(n) => PTok::Name(n.to_lowercase()),
+            Tok::Var(v) => PTok::Var(v.to_lowercase()),
+            Tok::Int(n) => PTok::Number(*n as f64),
+            Tok::Float(n) => PTok::Number(*n),
+            Tok::Punct("-") => PTok::Dash,
+            Tok::Punct("=") => PTok::Name("=".into()),
+            other => {
+                diags.push(Diagnostic::error(
+                    codes::R_SYNTAX,
+                    s,
+                    format!("{other} cannot appear in a PDDL formula"),
+                ));
+                PTok::Invalid(other.to_string())
+            }
+        };
+        ptoks.push(PToken { tok: pt, span: s });
+        j += 1;
+        if depth == 0 {
+            break;
+        }
+    }
+    let start = rel(tokens[i].1, offset).start;
+    let end = rel(tokens[j - 1].1, offset).end;
+    let (forest, sdiags) = sexpr::build(ptoks);
+    diags.extend(sdiags);
+    let tok = match forest.first() {
+        Some(sx) if effect => match effect_of(sx) {
+            (Some(e), d) => {
+                diags.extend(d);
+                Tok::Effect(Box::new(e))
+            }
+            (None, d) => {
+                diags.extend(d);
+                Tok::BadPddl
+            }
+        },
+        Some(sx) => match formula_of(sx) {
+            (Some(f), d) => {
+                diags.extend(d);
+                Tok::Formula(Box::new(f))
+            }
+            (None, d) => {
+                diags.extend(d);
+                Tok::BadPddl
+            }
+        },
+        None => Tok::BadPddl,
+    };
+    ((tok, SimpleSpan::from(start..end)), j)
+}
+
+fn parse_item(tokens: &[(Tok, Span)], offset: u32, file: FileId) -> (Item, Vec<Diagnostic>) {
+    let mut diags = Vec::new();
+    let whole = Span::new(
+        file,
+        0,
+        (tokens.last().map_or(offset, |t| t.1.end) - offset) as usize,
+    );
+    // Pre-pass: relative spans, PDDL groups read, nesting bounded.
+    let mut input: Vec<(Tok, SimpleSpan)> = Vec::with_capacity(tokens.len());
+    let is_condition = matches!(tokens.first(), Some((Tok::Ident(k), _)) if k == "condition");
+    let mut depth = 0usize;
+    let mut i = 0;
+    while i < tokens.len() {
+        let (t, span) = &tokens[i];
+        let prev = input.last().map(|p| &p.0);
+        if matches!(t, Tok::Punct("(")) {
+            let effect = matches!(prev, Some(Tok::Ident(k)) if k == "effect");
+            let formula = is_condition && matches!(prev, Some(Tok::Punct("=")));
+            if effect || formula {
+                let (tok, next) = read_pddl_group(tokens, i, offset, file, effect, &mut diags);
+                input.push(tok);
+                i = next;
+                continue;
+            }
+        }
+        match t {
+            Tok::Punct("(" | "{" | "[") => {
+                depth += 1;
+                if depth > MAX_ITEM_DEPTH {
+                    diags.push(Diagnostic::error(
+                        codes::R_SYNTAX,
+                        Span::new(file, rel(*span, offset).start, rel(*span, offset).end),
+                        format!("brackets are nested more than {MAX_ITEM_DEPTH} levels deep"),
+                    ));
+                    return (Item::Error { span: whole }, diags);
+                }
+            }
+            Tok::Punct(")" | "}" | "]") => depth = depth.saturating_sub(1),
+            _ => {}
+        }
+        input.push((t.clone(), rel(*span, offset)));
+        i += 1;
+    }
+    let eoi = SimpleSpan::from(whole.end as usize..whole.end as usize);
+    let (item, errors) = item_parser(file)
+        .parse(input.as_slice().map(eoi, |(t, s)| (t, s)))
+        .into_output_errors();
+    for e in errors {
+        diags.push(rich_to_diagnostic(&e, file));
+    }
+    (item.unwrap_or(Item::Error { span: whole }), diags)
+}
+
+fn rich_to_diagnostic(e: &Rich<'_, Tok, SimpleSpan>, file: FileId) -> Diagnostic {
+    let span = Span::new(file, e.span().start, e.span().end);
+    let found = match e.found() {
+        Some(t) => t.to_string(),
+        None => "the end of the item".to_owned(),
+    };
+    let mut expected: Vec<String> = e
+        .expected()
+        .map(|p| p.to_string())
+        .filter(|p| p != "something else")
+        .collect();
+    expected.sort();
+    expected.dedup();
+    let message = match (e.reason(), expected.as_slice()) {
+        (chumsky::error::RichReason::Custom(msg), _) => msg.to_string(),
+        (_, []) => format!("unexpected {found}"),
+        (_, [one]) => format!("expected {one}, found {found}"),
+        (_, many) => format!("expected one of {}, found {found}", many.join(", ")),
+    };
+    Diagnostic::error(codes::R_SYNTAX, span, message)
+}
+
+type Err<'t> = extra::Err<Rich<'t, Tok, SimpleSpan>>;
+
+fn kw<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
+    word: &'static str,
+) -> impl Parser<'t, I, (), Err<'t>> + Clone {
+    just(Tok::Ident(word.to_owned())).ignored().labelled(word)
+}
+
+fn punct<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
+    p: &'static str,
+) -> impl Parser<'t, I, (), Err<'t>> + Clone {
+    just(Tok::Punct(p)).ignored()
+}
+
+fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
+    file: FileId,
+) -> impl Parser<'t, I, Item, Err<'t>> {
+    let sp = move |s: SimpleSpan| Span::new(file, s.start, s.end);
+    let ident = select! { Tok::Ident(s) => s }
+        .map_with(move |text, e| Ident {
+            text,
+            span: sp(e.span()),
+        })
+        .labelled("a name");
+    let var = select! { Tok::Var(s) => s }
+        .map_with(move |text: String, e| Ident {
+            text: text.to_lowercase(),
+            span: sp(e.span()),
+        })
+        .labelled("a variable");
+    let int = select! { Tok::Int(n) => n }.labelled("a whole number");
+    let count = int.try_map(|n, span| {
+        u32::try_from(n).map_err(|_| Rich::custom(span, "expected a count from 0 to 4294967295"))
+    });
+    let strlit = select! { Tok::Str(s) => s }
+        .try_map(move |raw, span: SimpleSpan| {
+            interpolate(&raw, file, span.start).map_err(|(msg, at)| Rich::custom(at, msg))
+        })
+        .labelled("a string");
+
+    let literal = choice((
+        int.map_with(move |value, e| Literal::Int {
+            value,
+            span: sp(e.span()),
+        }),
+        select! { Tok::Float(f) => f }.map_with(move |value, e| Literal::Float {
+            value,
+            span: sp(e.span()),
+        }),
+        strlit.clone().map(|value| Literal::Str { value }),
+        kw("true").map_with(move |_, e| Literal::Bool {
+            value: true,
+            span: sp(e.span()),
+        }),
+        kw("false").map_with(move |_, e| Literal::Bool {
+            value: false,
+            span: sp(e.span()),
+        }),
+        ident.clone().map(|name| Literal::Name { name }),
+    ))
+    .labelled("a value");
+
+    let value = recursive(|value| {
+        choice((
+            var.clone().map(|name| Value::Var { name }),
+            strlit.clone().map(|value| Value::Str { value }),
+            int.map_with(move |value, e| Value::Int {
+                value,
+                span: sp(e.span()),
+            }),
+            select! { Tok::Float(f) => f }.map_with(move |value, e| Value::Float {
+                value,
+                span: sp(e.span()),
+            }),
+            kw("true").map_with(move |_, e| Value::Bool {
+                value: true,
+                span: sp(e.span()),
+            }),
+            kw("false").map_with(move |_, e| Value::Bool {
+                value: false,
+                span: sp(e.span()),
+            }),
+            ident
+                .clone()
+                .then(value.delimited_by(punct("["), punct("]")))
+                .map_with(move |(table, key), e| Value::Lookup {
+                    table,
+                    key: Box::new(key),
+                    span: sp(e.span()),
+                }),
+            ident.clone().map(|name| Value::Name { name }),
+        ))
+        .labelled("a value")
+    });
+
+    let ports = kw("out")
+        .or_not()
+        .then(ident.clone())
+        .then_ignore(punct(":"))
+        .then(ident.clone())
+        .map_with(move |((out, name), ty), e| PortDecl {
+            out: out.is_some(),
+            name,
+            ty,
+            span: sp(e.span()),
+        })
+        .separated_by(punct(","))
+        .allow_trailing()
+        .collect::<Vec<_>>()
+        .delimited_by(punct("("), punct(")"))
+        .labelled("a port list such as `(robot: robot)`");
+
+    let template = recursive(|template| {
+        let block = template
+            .clone()
+            .repeated()
+            .collect::<Vec<Template>>()
+            .delimited_by(punct("{"), punct("}"))
+            .recover_with(via_parser(nested_delimiters(
+                Tok::Punct("{"),
+                Tok::Punct("}"),
+                [
+                    (Tok::Punct("("), Tok::Punct(")")),
+                    (Tok::Punct("["), Tok::Punct("]")),
+                ],
+                move |s| vec![Template::Error { span: sp(s) }],
+            )));
+        let parallel_args = kw("success")
+            .ignore_then(punct(":"))
+            .ignore_then(count)
+            .then_ignore(punct(","))
+            .then_ignore(kw("failure"))
+            .then_ignore(punct(":"))
+            .then(count)
+            .delimited_by(punct("("), punct(")"));
+        let control_kind = choice((
+            kw("sequence").to(ControlKind::Sequence),
+            kw("reactive_sequence").to(ControlKind::ReactiveSequence),
+            kw("fallback").to(ControlKind::Fallback),
+            kw("reactive_fallback").to(ControlKind::ReactiveFallback),
+            kw("parallel")
+                .ignore_then(parallel_args)
+                .map(|(success, failure)| ControlKind::Parallel { success, failure }),
+        ));
+        let control = control_kind
+            .then(strlit.clone().or_not())
+            .then(block)
+            .map_with(move |((control, name), children), e| Template::Control {
+                control,
+                name,
+                children,
+                span: sp(e.span()),
+            });
+        let arg1 = |k: &'static str| kw(k).ignore_then(count.delimited_by(punct("("), punct(")")));
+        let decorator_kind = choice((
+            arg1("retry").map(|times| DecoratorKind::Retry { times }),
+            arg1("repeat").map(|times| DecoratorKind::Repeat { times }),
+            arg1("timeout").map(|ms| DecoratorKind::Timeout { ms: ms as u64 }),
+            kw("inverter").to(DecoratorKind::Inverter),
+            kw("force_success").to(DecoratorKind::ForceSuccess),
+            kw("force_failure").to(DecoratorKind::ForceFailure),
+        ));
+        let decorator = decorator_kind
+            .then(strlit.clone().or_not())
+            .then(template.clone())
+            .map_with(move |((decorator, name), child), e| Template::Decorator {
+                decorator,
+                name,
+                child: Box::new(child),
+                span: sp(e.span()),
+            });
+        let steps = kw("steps")
+            .ignore_then(
+                choice((
+                    kw("parallel")
+                        .then_ignore(punct("(").not().rewind())
+                        .to(StepsMode::Parallel),
+                    kw("backchained").to(StepsMode::Backchained),
+                ))
+                .or_not(),
+            )
+            .map_with(move |mode, e| Template::Steps {
+                mode: mode.unwrap_or(StepsMode::InOrder),
+                span: sp(e.span()),
+            });
+        let arg = ident
+            .clone()
+            .then_ignore(punct(":"))
+            .then(value.clone())
+            .map(|(port, value)| Arg { port, value });
+        let call = ident
+            .clone()
+            .then(
+                arg.separated_by(punct(","))
+                    .allow_trailing()
+                    .collect::<Vec<_>>()
+                    .delimited_by(punct("("), punct(")")),
+            )
+            .map_with(move |(name, args), e| Template::Call {
+                name,
+                args,
+                span: sp(e.span()),
+            });
+        choice((steps, control, decorator, call))
+            .labelled("a node, a control such as `sequence`, or a decorator")
+    });
+
+    let body_block = template
+        .clone()
+        .repeated()
+        .collect::<Vec<_>>()
+        .delimited_by(punct("{"), punct("}"))
+        .recover_with(via_parser(nested_delimiters(
+            Tok::Punct("{"),
+            Tok::Punct("}"),
+            [
+                (Tok::Punct("("), Tok::Punct(")")),
+                (Tok::Punct("["), Tok::Punct("]")),
+            ],
+            move |s| vec![Template::Error { span: sp(s) }],
+        )));
+
+    let formula = select! { Tok::Formula(f) => Some(*f), Tok::BadPddl => None }
+        .labelled("a PDDL formula in parentheses");
+    let effect = select! { Tok::Effect(f) => Some(*f), Tok::BadPddl => None }
+        .labelled("a PDDL effect in parentheses");
+
+    let domain = kw("domain")
+        .ignore_then(strlit.clone())
+        .map_with(move |path, e| Item::Domain {
+            path,
+            span: sp(e.span()),
+        });
+    let problem = kw("problem")
+        .ignore_then(strlit.clone())
+        .map_with(move |path, e| Item::Problem {
+            path,
+            span: sp(e.span()),
+        });
+    let import = kw("import")
+        .ignore_then(choice((
+            strlit.clone().map(|path| ImportTarget::Path { path }),
+            kw("std")
+                .ignore_then(punct("::"))
+                .ignore_then(ident.clone())
+                .map(|module| ImportTarget::Std { module }),
+        )))
+        .map_with(move |target, e| Item::Import {
+            target,
+            span: sp(e.span()),
+        });
+    let node = choice((
+        kw("action").to(NodeKind::Action),
+        kw("condition").to(NodeKind::Condition),
+    ))
+    .then(ident.clone())
+    .then(ports.clone())
+    .then(punct("=").ignore_then(formula).or_not())
+    .validate(move |(((kind, name), ports), formula), e, emitter| {
+        if kind == NodeKind::Action && formula.is_some() {
+            emitter.emit(Rich::custom(
+                e.span(),
+                "only a `condition` can be defined by a formula",
+            ));
+        }
+        Item::Node(NodeDecl {
+            kind,
+            name,
+            ports,
+            formula: formula.flatten(),
+            span: sp(e.span()),
+        })
+    });
+    let tree = kw("tree")
+        .ignore_then(ident.clone())
+        .then(ports)
+        .then(body_block.clone())
+        .map_with(move |((name, ports), body), e| {
+            Item::Tree(TreeDecl {
+                name,
+                ports,
+                body,
+                span: sp(e.span()),
+            })
+        });
+    let table = kw("table")
+        .ignore_then(ident.clone())
+        .then(
+            ident
+                .clone()
+                .then_ignore(punct(":"))
+                .then(literal)
+                .map(|(key, value)| TableEntry { key, value })
+                .separated_by(punct(","))
+                .allow_trailing()
+                .collect::<Vec<_>>()
+                .delimited_by(punct("{"), punct("}")),
+        )
+        .map_with(move |(name, entries), e| {
+            Item::Table(TableDecl {
+                name,
+                entries,
+                span: sp(e.span()),
+            })
+        });
+
+    let name_part = choice((
+        ident.clone().map(|i| NamePart::Lit {
+            text: i.text,
+            span: i.span,
+        }),
+        ident
+            .clone()
+            .delimited_by(punct("{"), punct("}"))
+            .map(|name| NamePart::Capture { name }),
+    ));
+    let param = choice((
+        var.clone().map_with(move |var, e| Param {
+            var,
+            optional: false,
+            span: sp(e.span()),
+        }),
+        var.clone()
+            .delimited_by(punct("["), punct("]"))
+            .map_with(move |var, e| Param {
+                var,
+                optional: true,
+                span: sp(e.span()),
+            }),
+    ));
+    let pattern = name_part
+        .map_with(|p, e| (p, e.span()))
+        .repeated()
+        .at_least(1)
+        .collect::<Vec<(NamePart, SimpleSpan)>>()
+        .validate(|parts, _, emitter| {
+            for w in parts.windows(2) {
+                if w[0].1.end != w[1].1.start {
+                    emitter.emit(Rich::custom(
+                        w[1].1,
+                        "the parts of an action-name pattern must touch: write `PICK_{op}`, without spaces",
+                    ));
+                }
+            }
+            parts.into_iter().map(|(p, _)| p).collect::<Vec<_>>()
+        })
+        .then(param.repeated().collect::<Vec<_>>())
+        .delimited_by(punct("("), punct(")"))
+        .map_with(move |(name, params), e| Pattern { name, params, span: sp(e.span()) })
+        .labelled("an action pattern such as `(move ?robot ?from ?to)`");
+    let guard = choice((
+        var.clone()
+            .then_ignore(punct("!="))
+            .then(var.clone())
+            .map_with(move |(left, right), e| Guard::Ne {
+                left,
+                right,
+                span: sp(e.span()),
+            }),
+        var.clone()
+            .then_ignore(punct("=="))
+            .then(var.clone())
+            .map_with(move |(left, right), e| Guard::Eq {
+                left,
+                right,
+                span: sp(e.span()),
+            }),
+        var.clone()
+            .then_ignore(punct("-"))
+            .then(ident.clone())
+            .map_with(move |(var, ty), e| Guard::IsType {
+                var,
+                ty,
+                span: sp(e.span()),
+            }),
+        ident
+            .clone()
+            .then_ignore(kw("in"))
+            .then(ident.clone())
+            .map_with(move |(key, table), e| Guard::InTable {
+                key,
+                table,
+                span: sp(e.span()),
+            }),
+    ))
+    .labelled("a guard such as `?a != ?b`");
+    let rule_body = choice((
+        punct("=>")
+            .ignore_then(kw("skip"))
+            .map_with(move |_, e| RuleBody::Skip { span: sp(e.span()) }),
+        template
+            .clone()
+            .repeated()
+            .collect::<Vec<_>>()
+            .then(kw("effect").ignore_then(effect).or_not())
+            .delimited_by(punct("{"), punct("}"))
+            .map(|(body, effect)| RuleBody::Template {
+                body,
+                effect: effect.flatten(),
+            })
+            .recover_with(via_parser(nested_delimiters(
+                Tok::Punct("{"),
+                Tok::Punct("}"),
+                [
+                    (Tok::Punct("("), Tok::Punct(")")),
+                    (Tok::Punct("["), Tok::Punct("]")),
+                ],
+                move |s| RuleBody::Template {
+                    body: vec![Template::Error { span: sp(s) }],
+                    effect: None,
+                },
+            ))),
+    ));
+    let rule = kw("rule")
+        .ignore_then(pattern)
+        .then(
+            kw("where")
+                .ignore_then(
+                    guard
+                        .separated_by(punct(","))
+                        .at_least(1)
+                        .collect::<Vec<_>>(),
+                )
+                .or_not(),
+        )
+        .then(rule_body)
+        .map_with(move |((pattern, guards), body), e| {
+            Item::Rule(Rule {
+                pattern,
+                guards: guards.unwrap_or_default(),
+                body,
+                span: sp(e.span()),
+            })
+        });
+    let plan = kw("plan")
+        .ignore_then(body_block)
+        .map_with(move |body, e| Item::Plan {
+            body,
+            span: sp(e.span()),
+        });
+
+    choice((domain, problem, import, node, tree, table, rule, plan))
+        .labelled(
+            "an item: `domain`, `import`, `action`, `condition`, `tree`, `table`, `rule` or `plan`",
+        )
+        .then_ignore(end())
+}
+
+/// Splits a string literal's raw text at `{?var}` / `{capture}` and
+/// processes escapes. `start` is the offset of the opening quote.
+fn interpolate(raw: &str, file: FileId, start: usize) -> Result<StrLit, (String, SimpleSpan)> {
+    let mut parts = Vec::new();
+    let mut text = String::new();
+    let base = start + 1;
+    let mut chars = raw.char_indices().peekable();
+    while let Some((i, c)) = chars.next() {
+        match c {
+            '\\' => match chars.next() {
+                Some((_, 'n')) => text.push('\n'),
+                Some((_, 't')) => text.push('\t'),
+                Some((_, c @ ('\\' | '"' | '{' | '}'))) => text.push(c),
+                Some((j, c)) => {
+                    return Err((format!("`\\{c}` is not an escape; use `\\\\`, `\\\"`, `\\n`, `\\t`, `\\{{` or `\\}}`"), SimpleSpan::from(base + i..base + j + c.len_utf8())))
+                }
+                None => return Err(("a string cannot end with `\\`".into(), SimpleSpan::from(base + i..base + i + 1))),
+            },
+            '{' => {
+                let close = raw[i..].find('}').map(|k| i + k);
+                let Some(close) = close else {
+                    return Err(("`{` opens an interpolation that is never closed; write `\\{` for a brace".into(), SimpleSpan::from(base + i..base + i + 1)));
+                };
+                let inner = &raw[i + 1..close];
+                let span = Span::new(file, base + i + 1, base + close);
+                let (is_var, name) = match inner.strip_prefix('?') {
+                    Some(v) => (true, v),
+                    None => (false, inner),
+                };
+                if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
+                    return Err((format!("`{{{inner}}}` is not `{{?variable}}` or `{{capture}}`"), SimpleSpan::from(base + i..base + close + 1)));
+                }
+                if !text.is_empty() {
+                    parts.push(StrPart::Text { text: std::mem::take(&mut text) });
+                }
+                parts.push(if is_var {
+                    StrPart::Var { name: Ident { text: name.to_lowercase(), span } }
+                } else {
+                    StrPart::Capture { name: Ident { text: name.to_owned(), span } }
+                });
+                while chars.peek().is_some_and(|(k, _)| *k <= close) {
+                    chars.next();
+                }
+            }
+            c => text.push(c),
+        }
+    }
+    if !text.is_empty() || parts.is_empty() {
+        parts.push(StrPart::Text { text });
+    }
+    Ok(StrLit {
+        parts,
+        span: Span::new(file, start, start + raw.len() + 2),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> ParsedRules {
+        parse_rules(text, 0)
+    }
+
+    fn codes(p: &ParsedRules) -> Vec<(&'static str, u32)> {
+        p.diagnostics
+            .iter()
+            .map(|d| (d.code, d.span.start))
+            .collect()
+    }
+
+    #[test]
+    fn the_design_examples_parse_without_errors() {
+        for text in [
+            include_str!("../../../examples/ariac/rules.btrules"),
+            include_str!("../../../examples/p3_assembler/rules.btrules"),
+        ] {
+            let p = parse(text);
+            assert!(p.diagnostics.is_empty(), "{:#?}", p.diagnostics);
+            assert!(p
+                .items
+                .iter()
+                .all(|i| !matches!(i.item, Item::Error { .. })));
+        }
+    }
+
+    #[test]
+    fn reads_patterns_guards_and_effects() {
+        let p = parse("rule (PICK_{op} ?a [?loc]) where op in markers, ?a != ?loc {\n  Pick(agent: ?A, marker: markers[op])\n  effect (and (holding ?a) (not (free ?a)))\n}");
+        assert!(p.diagnostics.is_empty(), "{:#?}", p.diagnostics);
+        let Item::Rule(r) = &p.items[0].item else {
+            panic!()
+        };
+        assert_eq!(r.pattern.name_text(), "PICK_{op}");
+        assert!(r.pattern.params[1].optional);
+        assert_eq!(r.guards.len(), 2);
+        let RuleBody::Template { body, effect } = &r.body else {
+            panic!()
+        };
+        assert!(effect.is_some());
+        let Template::Call { args, .. } = &body[0] else {
+            panic!()
+        };
+        assert!(matches!(&args[0].value, Value::Var { name } if name.text == "a"));
+        assert!(matches!(&args[1].value, Value::Lookup { .. }));
+    }
+
+    #[test]
+    fn spans_are_relative_to_their_item() {
+        let p = parse("action A()\n\naction B(x: int)");
+        assert_eq!(p.items[1].offset, 12);
+        let Item::Node(n) = &p.items[1].item else {
+            panic!()
+        };
+        assert_eq!(n.name.span, Span::new(0, 7, 8));
+    }
+
+    #[test]
+    fn a_broken_item_does_not_hide_the_next_ones() {
+        let text = "rule (move ?r ?a ?b) {\n  MoveTo(robot: ?r, target: )\n}\nrule (pick ?r) {\n  Pick(robot ?r)\n}\naction Pick(robot: robot)\n";
+        let p = parse(text);
+        assert_eq!(codes(&p).len(), 2, "{:#?}", p.diagnostics);
+        assert_eq!(p.items.len(), 3);
+        assert!(matches!(p.items[2].item, Item::Node(_)));
+    }
+
+    #[test]
+    fn a_missing_brace_is_recovered_at_the_next_line_start_keyword() {
+        let text =
+            "rule (move ?r ?a ?b) {\n  MoveTo(robot: ?r)\nrule (pick ?r) { Pick(robot: ?r) }\n";
+        let p = parse(text);
+        assert_eq!(p.items.len(), 2);
+        assert_eq!(p.diagnostics.len(), 1, "{:#?}", p.diagnostics);
+        assert!(matches!(p.items[1].item, Item::Rule(_)));
+    }
+
+    #[test]
+    fn interpolation_and_escapes() {
+        let p = parse("tree T() { sequence \"move {?Robot} to {op} \\{x\\}\" { } }");
+        assert!(p.diagnostics.is_empty(), "{:#?}", p.diagnostics);
+        let Item::Tree(t) = &p.items[0].item else {
+            panic!()
+        };
+        let Template::Control { name: Some(s), .. } = &t.body[0] else {
+            panic!()
+        };
+        assert_eq!(s.parts.len(), 5);
+        assert!(matches!(&s.parts[1], StrPart::Var { name } if name.text == "robot"));
+        assert!(matches!(&s.parts[4], StrPart::Text { text } if text == " {x}"));
+    }
+
+    #[test]
+    fn deep_nesting_is_refused_not_overflowed() {
+        let text = format!(
+            "plan {{ {} steps {} }}",
+            "sequence { ".repeat(5000),
+            "} ".repeat(5000)
+        );
+        let p = parse(&text);
+        assert!(p.diagnostics.iter().any(|d| d.message.contains("nested")));
+        let formula = format!(
+            "condition C() = {}(p){}",
+            "(not ".repeat(5000),
+            ")".repeat(5000)
+        );
+        let p = parse(&formula);
+        assert!(p.diagnostics.iter().any(|d| d.code == "P004"));
+    }
+}
