@@ -6,6 +6,7 @@
 //! touches the file system except [`source::load`]; the CLI and the language
 //! server do the IO and render [`diagnostic::Diagnostic`] values.
 
+pub mod db;
 pub mod diagnostic;
 pub mod pddl;
 pub mod pipeline;

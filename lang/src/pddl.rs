@@ -4,6 +4,7 @@ pub mod ast;
 pub mod check;
 pub mod lexer;
 pub mod parse;
+pub mod print;
 pub mod sexpr;
 pub mod types;
 

@@ -31,7 +31,11 @@ pub struct PlanUnit {
 }
 
 pub fn domain_unit(sources: &Sources, file: FileId) -> DomainUnit {
-    let (domain, mut diagnostics) = pddl::parse_domain(sources.text(file), file);
+    domain_unit_from(sources.text(file), file)
+}
+
+pub fn domain_unit_from(text: &str, file: FileId) -> DomainUnit {
+    let (domain, mut diagnostics) = pddl::parse_domain(text, file);
     let index = match &domain {
         Some(d) => {
             let (index, diags) = pddl::check_domain(d);
@@ -49,10 +53,24 @@ pub fn domain_unit(sources: &Sources, file: FileId) -> DomainUnit {
 }
 
 pub fn problem_unit(sources: &Sources, file: FileId, domain: &DomainUnit) -> ProblemUnit {
-    let (problem, mut diagnostics) = pddl::parse_problem(sources.text(file), file);
-    let index = match (&problem, &domain.domain) {
+    problem_unit_from(
+        sources.text(file),
+        file,
+        domain.domain.as_ref(),
+        &domain.index,
+    )
+}
+
+pub fn problem_unit_from(
+    text: &str,
+    file: FileId,
+    domain: Option<&Domain>,
+    dix: &DomainIndex,
+) -> ProblemUnit {
+    let (problem, mut diagnostics) = pddl::parse_problem(text, file);
+    let index = match (&problem, domain) {
         (Some(p), Some(d)) => {
-            let (index, diags) = pddl::check_problem(p, d, &domain.index);
+            let (index, diags) = pddl::check_problem(p, d, dix);
             diagnostics.extend(diags);
             index
         }

@@ -1,8 +1,10 @@
 //! The `.btrules` language: lexer, syntax tree, parser, formatter.
 
 pub mod ast;
+pub mod check;
 pub mod fmt;
 pub mod lexer;
+pub mod matching;
 pub mod parse;
 
 pub use ast::*;

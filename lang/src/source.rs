@@ -79,7 +79,7 @@ impl SourceFile {
 /// The set of files one command works on. Diagnostics refer to files by id.
 #[derive(Clone, Debug, Default)]
 pub struct Sources {
-    files: Vec<SourceFile>,
+    files: std::collections::BTreeMap<FileId, SourceFile>,
 }
 
 impl Sources {
@@ -87,13 +87,22 @@ impl Sources {
         Sources::default()
     }
 
+    /// Adds a file under the next free id.
     pub fn add(&mut self, path: impl Into<String>, text: impl Into<String>) -> FileId {
-        self.files.push(SourceFile::new(path, text));
-        (self.files.len() - 1) as FileId
+        let id = self.files.keys().next_back().map_or(0, |k| k + 1);
+        self.insert(id, path, text);
+        id
     }
 
+    /// Adds (or replaces) a file under a given id, e.g. the database's.
+    pub fn insert(&mut self, id: FileId, path: impl Into<String>, text: impl Into<String>) {
+        self.files.insert(id, SourceFile::new(path, text));
+    }
+
+    /// The file with this id. Panics for an id never added: ids come from
+    /// the same `Sources` (or database) as the diagnostics that carry them.
     pub fn get(&self, id: FileId) -> &SourceFile {
-        &self.files[id as usize]
+        &self.files[&id]
     }
 
     pub fn text(&self, id: FileId) -> &str {
@@ -101,7 +110,7 @@ impl Sources {
     }
 
     pub fn iter(&self) -> impl Iterator<Item = (FileId, &SourceFile)> {
-        self.files.iter().enumerate().map(|(i, f)| (i as FileId, f))
+        self.files.iter().map(|(i, f)| (*i, f))
     }
 }
 

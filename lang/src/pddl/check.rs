@@ -9,7 +9,7 @@ use rustc_hash::{FxHashMap, FxHashSet};
 
 /// A declared predicate or function: index into the domain's list and
 /// resolved parameter types.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Signature {
     pub index: usize,
     pub params: Vec<Vec<TypeId>>,
@@ -18,7 +18,7 @@ pub struct Signature {
 
 /// An object or constant: its id in [`ProblemIndex::objects`] order (or
 /// in [`DomainIndex::constants`]), its types and where it is declared.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct ObjectInfo {
     pub id: u32,
     pub types: Vec<TypeId>,
@@ -26,7 +26,7 @@ pub struct ObjectInfo {
 }
 
 /// What a checked domain knows by name.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct DomainIndex {
     pub types: TypeTable,
     pub predicates: FxHashMap<String, Signature>,
@@ -44,7 +44,7 @@ pub struct DomainIndex {
 }
 
 /// What a checked problem knows: every object and constant, with ids.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct ProblemIndex {
     pub objects: FxHashMap<String, ObjectInfo>,
     /// Names by id: domain constants first, then the problem's objects.
@@ -226,7 +226,7 @@ struct Checker<'a> {
     durative: bool,
 }
 
-type Scope = Vec<(String, Vec<TypeId>)>;
+pub type Scope = Vec<(String, Vec<TypeId>)>;
 
 /// Checks a domain and builds its index.
 pub fn check_domain(domain: &Domain) -> (DomainIndex, Vec<Diagnostic>) {
@@ -477,6 +477,47 @@ pub fn check_problem(
     diags.append(&mut c.diags);
     diags.extend(undeclared_requirements(&c.used, &reqs));
     (pi, diags)
+}
+
+/// Checks a condition written outside the domain (in a rules file) with the
+/// given variables in scope. `problem` adds its objects to the constants.
+pub fn check_formula_in(
+    domain: &Domain,
+    index: &DomainIndex,
+    problem: Option<&ProblemIndex>,
+    f: &Formula,
+    scope: &[(String, Vec<TypeId>)],
+) -> Vec<Diagnostic> {
+    let mut c = Checker {
+        domain,
+        index,
+        problem,
+        diags: Vec::new(),
+        used: FxHashMap::default(),
+        durative: false,
+    };
+    c.formula(f, &scope.to_vec());
+    c.diags
+}
+
+/// Checks an effect written outside the domain, as [`check_formula_in`].
+pub fn check_effect_in(
+    domain: &Domain,
+    index: &DomainIndex,
+    problem: Option<&ProblemIndex>,
+    e: &Effect,
+    scope: &[(String, Vec<TypeId>)],
+) -> Vec<Diagnostic> {
+    let mut c = Checker {
+        domain,
+        index,
+        problem,
+        diags: Vec::new(),
+        used: FxHashMap::default(),
+        durative: false,
+    };
+    c.effect(e, &scope.to_vec());
+    c.diags
 }
 
 fn note_typed(t: &Typed, used: &mut FxHashMap<Feature, Span>) {

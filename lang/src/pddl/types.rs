@@ -10,7 +10,7 @@ pub type TypeId = u32;
 /// `object`, the root every type descends from.
 pub const OBJECT: TypeId = 0;
 
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct TypeTable {
     names: Vec<String>,
     ids: FxHashMap<String, TypeId>,

@@ -1,0 +1,556 @@
+//! The incremental database (salsa). Inputs are file texts; everything else
+//! is a tracked query. Each top-level item of a rules file is a tracked
+//! struct whose tree has item-relative spans, so an edit re-checks only the
+//! items it changed (see the tests at the end).
+
+use crate::diagnostic::{codes, Diagnostic};
+use crate::pddl::{ast::Domain, ast::Problem, DomainIndex, ProblemIndex};
+use crate::pipeline::{domain_unit_from, problem_unit_from};
+use crate::rules::check::{check_file, check_item, Decls, DomainCtx};
+use crate::rules::parse::shift;
+use crate::rules::{parse_rules, ImportTarget, Item, ItemNode, ParsedRules};
+use crate::source::{FileId, Sources, Span};
+use salsa::plumbing::AsId;
+use salsa::Setter;
+use std::collections::BTreeMap;
+use std::sync::{Arc, Mutex};
+
+/// One file's text. Paths are as the driver gave them (the stdlib's are
+/// `std::NAME`).
+#[salsa::input(debug)]
+pub struct SourceFile {
+    #[returns(ref)]
+    pub path: String,
+    #[returns(ref)]
+    pub text: String,
+}
+
+/// Every file the database knows, by path.
+#[salsa::input(debug)]
+pub struct Workspace {
+    #[returns(ref)]
+    pub files: BTreeMap<String, SourceFile>,
+}
+
+#[salsa::db]
+pub trait Db: salsa::Database {
+    fn workspace(&self) -> Workspace;
+}
+
+/// The stdlib modules built into the binary.
+pub const STDLIB: &[(&str, &str)] = &[
+    ("btcpp", include_str!("../../stdlib/btcpp.btrules")),
+    ("kb", include_str!("../../stdlib/kb.btrules")),
+    ("ariac", include_str!("../../stdlib/ariac.btrules")),
+    ("crcl", include_str!("../../stdlib/crcl.btrules")),
+];
+
+#[salsa::db]
+#[derive(Clone)]
+pub struct Database {
+    storage: salsa::Storage<Self>,
+    workspace: Option<Workspace>,
+    /// Names of queries executed, when logging is on (tests of incrementality).
+    log: Arc<Mutex<Option<Vec<String>>>>,
+}
+
+#[salsa::db]
+impl salsa::Database for Database {}
+
+#[salsa::db]
+impl Db for Database {
+    fn workspace(&self) -> Workspace {
+        self.workspace.expect("set in Database::new")
+    }
+}
+
+impl Default for Database {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Database {
+    pub fn new() -> Database {
+        let log: Arc<Mutex<Option<Vec<String>>>> = Arc::default();
+        let sink = log.clone();
+        let storage = salsa::Storage::new(Some(Box::new(move |event: salsa::Event| {
+            if let salsa::EventKind::WillExecute { database_key } = event.kind {
+                if let Some(log) = &mut *sink.lock().expect("log lock") {
+                    log.push(format!("{database_key:?}"));
+                }
+            }
+        })));
+        let mut db = Database {
+            storage,
+            workspace: None,
+            log,
+        };
+        let ws = Workspace::new(&db, BTreeMap::new());
+        db.workspace = Some(ws);
+        for (name, text) in STDLIB {
+            db.set_file(&format!("std::{name}"), text.to_string());
+        }
+        db
+    }
+
+    /// Adds a file or replaces its text.
+    pub fn set_file(&mut self, path: &str, text: String) -> SourceFile {
+        let ws = self.workspace();
+        if let Some(&f) = ws.files(self).get(path) {
+            if f.text(self) != &text {
+                f.set_text(self).to(text);
+            }
+            return f;
+        }
+        let f = SourceFile::new(self, path.to_owned(), text);
+        let mut files = ws.files(self).clone();
+        files.insert(path.to_owned(), f);
+        ws.set_files(self).to(files);
+        f
+    }
+
+    pub fn file(&self, path: &str) -> Option<SourceFile> {
+        self.workspace().files(self).get(path).copied()
+    }
+
+    /// Every file as [`Sources`] with the ids diagnostics use, for rendering.
+    pub fn sources(&self) -> Sources {
+        let mut s = Sources::new();
+        for f in self.workspace().files(self).values() {
+            s.insert(
+                file_id(self, *f),
+                f.path(self).clone(),
+                f.text(self).clone(),
+            );
+        }
+        s
+    }
+
+    pub fn start_logging(&self) {
+        *self.log.lock().expect("log lock") = Some(Vec::new());
+    }
+
+    pub fn take_log(&self) -> Vec<String> {
+        self.log
+            .lock()
+            .expect("log lock")
+            .as_mut()
+            .map(std::mem::take)
+            .unwrap_or_default()
+    }
+}
+
+/// The id spans use for a file: its salsa id, stable while the file exists.
+pub fn file_id(_db: &dyn Db, f: SourceFile) -> FileId {
+    f.as_id().index()
+}
+
+/// A rules file parsed.
+#[salsa::tracked(returns(ref))]
+pub fn parsed_rules(db: &dyn Db, file: SourceFile) -> ParsedRules {
+    parse_rules(file.text(db), file_id(db, file))
+}
+
+/// One top-level item. Identified by its file and head (kind and name or
+/// pattern), so inserting an item elsewhere keeps the others' identities.
+#[salsa::tracked(debug)]
+pub struct RulesItem<'db> {
+    #[returns(copy)]
+    pub file: SourceFile,
+    #[returns(ref)]
+    pub key: String,
+    #[tracked]
+    #[returns(ref)]
+    pub item: Item,
+    #[tracked]
+    #[returns(copy)]
+    pub offset: u32,
+}
+
+fn item_key(item: &Item) -> String {
+    match item {
+        Item::Domain { .. } => "domain".into(),
+        Item::Problem { .. } => "problem".into(),
+        Item::Import { target, .. } => match target {
+            ImportTarget::Path { path } => format!("import {:?}", path.plain()),
+            ImportTarget::Std { module } => format!("import std::{}", module.text),
+        },
+        Item::Node(n) => format!("node {}", n.name.text),
+        Item::Tree(t) => format!("tree {}", t.name.text),
+        Item::Table(t) => format!("table {}", t.name.text),
+        Item::Rule(r) => {
+            let params: Vec<String> = r
+                .pattern
+                .params
+                .iter()
+                .map(|p| p.var.text.clone())
+                .collect();
+            format!(
+                "rule {} {}",
+                r.pattern.name_text().to_lowercase(),
+                params.join(" ")
+            )
+        }
+        Item::Plan { .. } => "plan".into(),
+        Item::Error { .. } => "error".into(),
+    }
+}
+
+#[salsa::tracked(returns(ref))]
+pub fn rules_items(db: &dyn Db, file: SourceFile) -> Vec<RulesItem<'_>> {
+    parsed_rules(db, file)
+        .items
+        .iter()
+        .map(|n| RulesItem::new(db, file, item_key(&n.item), n.item.clone(), n.offset))
+        .collect()
+}
+
+/// Resolves a path written in a rules file (relative to that file).
+fn resolve(db: &dyn Db, from: SourceFile, written: &str) -> Option<SourceFile> {
+    let files = db.workspace().files(db);
+    let base = std::path::Path::new(from.path(db))
+        .parent()
+        .map(|p| p.to_path_buf())
+        .unwrap_or_default();
+    let joined = base.join(written);
+    let candidates = [
+        joined.to_string_lossy().into_owned(),
+        normalize(&joined),
+        written.to_owned(),
+    ];
+    candidates.iter().find_map(|c| files.get(c).copied())
+}
+
+/// `a/./b/../c` -> `a/c`, without touching the file system.
+pub fn normalize(p: &std::path::Path) -> String {
+    let mut out: Vec<String> = Vec::new();
+    for c in p.components() {
+        match c {
+            std::path::Component::CurDir => {}
+            std::path::Component::ParentDir if out.last().is_some_and(|l| l != "..") => {
+                out.pop();
+            }
+            other => out.push(other.as_os_str().to_string_lossy().into_owned()),
+        }
+    }
+    out.join("/")
+}
+
+/// The path a rules file gives for its domain (or problem), as written.
+pub fn declared_path(db: &dyn Db, file: SourceFile, problem: bool) -> Option<(String, Span, u32)> {
+    parsed_rules(db, file)
+        .items
+        .iter()
+        .find_map(|n| match &n.item {
+            Item::Domain { path, span } if !problem => path.plain().map(|p| (p, *span, n.offset)),
+            Item::Problem { path, span } if problem => path.plain().map(|p| (p, *span, n.offset)),
+            _ => None,
+        })
+}
+
+#[salsa::tracked(returns(copy))]
+pub fn domain_file(db: &dyn Db, rules: SourceFile) -> Option<SourceFile> {
+    let (path, _, _) = declared_path(db, rules, false)?;
+    resolve(db, rules, &path)
+}
+
+#[salsa::tracked(returns(copy))]
+pub fn problem_file(db: &dyn Db, rules: SourceFile) -> Option<SourceFile> {
+    let (path, _, _) = declared_path(db, rules, true)?;
+    resolve(db, rules, &path)
+}
+
+/// A PDDL domain parsed and checked.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CheckedDomain {
+    pub domain: Option<Domain>,
+    pub index: DomainIndex,
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+#[salsa::tracked(returns(ref))]
+pub fn checked_domain(db: &dyn Db, file: SourceFile) -> CheckedDomain {
+    let u = domain_unit_from(file.text(db), file_id(db, file));
+    CheckedDomain {
+        domain: u.domain,
+        index: u.index,
+        diagnostics: u.diagnostics,
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct CheckedProblem {
+    pub problem: Option<Problem>,
+    pub index: ProblemIndex,
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+/// A problem checked against a domain. (Inputs are salsa structs, so the
+/// pair is interned.)
+#[salsa::interned(debug)]
+pub struct ProblemOf<'db> {
+    #[returns(copy)]
+    pub problem: SourceFile,
+    #[returns(copy)]
+    pub domain: SourceFile,
+}
+
+#[salsa::tracked(returns(ref))]
+pub fn checked_problem<'db>(db: &'db dyn Db, pair: ProblemOf<'db>) -> CheckedProblem {
+    let d = checked_domain(db, pair.domain(db));
+    let u = problem_unit_from(
+        pair.problem(db).text(db),
+        file_id(db, pair.problem(db)),
+        d.domain.as_ref(),
+        &d.index,
+    );
+    CheckedProblem {
+        problem: u.problem,
+        index: u.index,
+        diagnostics: u.diagnostics,
+    }
+}
+
+/// A rules file and every file it imports, transitively, in order; import
+/// errors with absolute spans. Iterative, so import cycles are harmless.
+#[salsa::tracked(returns(ref))]
+pub fn import_closure(db: &dyn Db, file: SourceFile) -> (Vec<SourceFile>, Vec<Diagnostic>) {
+    let mut order = vec![file];
+    let mut diags = Vec::new();
+    let mut i = 0;
+    while i < order.len() {
+        let f = order[i];
+        i += 1;
+        for n in &parsed_rules(db, f).items {
+            let Item::Import { target, span } = &n.item else {
+                continue;
+            };
+            let found = match target {
+                ImportTarget::Std { module } => db
+                    .workspace()
+                    .files(db)
+                    .get(&format!("std::{}", module.text))
+                    .copied(),
+                ImportTarget::Path { path } => path.plain().and_then(|p| resolve(db, f, &p)),
+            };
+            match found {
+                Some(g) if !order.contains(&g) => order.push(g),
+                Some(_) => {}
+                None if f == file => {
+                    let (what, hint) = match target {
+                        ImportTarget::Std { module } => (
+                            format!("there is no stdlib module `std::{}`", module.text),
+                            format!(
+                                "the stdlib modules are {}",
+                                STDLIB
+                                    .iter()
+                                    .map(|(n, _)| format!("`std::{n}`"))
+                                    .collect::<Vec<_>>()
+                                    .join(", ")
+                            ),
+                        ),
+                        ImportTarget::Path { path } => (
+                            format!("cannot find `{}`", path.plain().unwrap_or_default()),
+                            "import paths are relative to the importing file".to_owned(),
+                        ),
+                    };
+                    let d = Diagnostic::error(codes::R_IMPORT, *span, what).with_hint(hint);
+                    diags.push(shift(d, file_id(db, file), n.offset));
+                }
+                None => {}
+            }
+        }
+    }
+    (order, diags)
+}
+
+/// Declarations visible in a rules file: its own first, then its imports'.
+#[salsa::tracked(returns(ref))]
+pub fn declarations(db: &dyn Db, file: SourceFile) -> Decls {
+    let mut decls = Decls::default();
+    for f in &import_closure(db, file).0 {
+        decls.add_items(&parsed_rules(db, *f).items);
+    }
+    decls
+}
+
+/// Diagnostics of one item, relative to its start. Reads only the item's
+/// tree, the declarations and the PDDL files, so edits elsewhere in the file
+/// leave it alone.
+#[salsa::tracked(returns(ref))]
+pub fn item_diagnostics<'db>(db: &'db dyn Db, item: RulesItem<'db>) -> Vec<Diagnostic> {
+    let file = item.file(db);
+    let decls = declarations(db, file);
+    let domain = domain_file(db, file);
+    let problem = problem_file(db, file);
+    let cd = domain.map(|d| checked_domain(db, d));
+    let cp = match (problem, domain) {
+        (Some(p), Some(d)) => Some(checked_problem(db, ProblemOf::new(db, p, d))),
+        _ => None,
+    };
+    let ctx = cd.and_then(|c| {
+        c.domain.as_ref().map(|domain| DomainCtx {
+            domain,
+            index: &c.index,
+            problem: cp.map(|p| &p.index),
+        })
+    });
+    check_item(item.item(db), decls, ctx, file_id(db, file))
+}
+
+/// Every diagnostic of a rules file itself (not of its PDDL files), with
+/// absolute spans.
+#[salsa::tracked(returns(ref))]
+pub fn rules_diagnostics(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
+    let id = file_id(db, file);
+    let parsed = parsed_rules(db, file);
+    let mut out = parsed.diagnostics.clone();
+    out.extend(import_closure(db, file).1.iter().cloned());
+    for item in rules_items(db, file) {
+        let offset = item.offset(db);
+        out.extend(
+            item_diagnostics(db, *item)
+                .iter()
+                .cloned()
+                .map(|d| shift(d, id, offset)),
+        );
+    }
+    let domain = domain_file(db, file);
+    if let Some((path, span, offset)) = declared_path(db, file, false) {
+        if domain.is_none() {
+            out.push(shift(
+                Diagnostic::error(
+                    codes::R_NO_DOMAIN,
+                    span,
+                    format!("cannot find the domain file `{path}`"),
+                )
+                .with_hint("the path is relative to this rules file"),
+                id,
+                offset,
+            ));
+        } else if let Some(d) = domain {
+            let errors = checked_domain(db, d)
+                .diagnostics
+                .iter()
+                .filter(|d| d.is_error())
+                .count();
+            if errors > 0 {
+                out.push(shift(
+                    Diagnostic::error(codes::R_NO_DOMAIN, span, format!("the domain `{path}` has {errors} error{}; rules are checked against what could be read", if errors == 1 { "" } else { "s" })),
+                    id,
+                    offset,
+                ));
+            }
+        }
+    }
+    if let Some((path, span, offset)) = declared_path(db, file, true) {
+        if problem_file(db, file).is_none() {
+            out.push(shift(
+                Diagnostic::error(
+                    codes::R_NO_DOMAIN,
+                    span,
+                    format!("cannot find the problem file `{path}`"),
+                ),
+                id,
+                offset,
+            ));
+        }
+    }
+    let cd = domain.map(|d| checked_domain(db, d));
+    let ctx = cd.and_then(|c| {
+        c.domain.as_ref().map(|domain| DomainCtx {
+            domain,
+            index: &c.index,
+            problem: None,
+        })
+    });
+    out.extend(check_file(&parsed.items, declarations(db, file), ctx, id));
+    out.sort_by_key(|d| (d.span.file != id, d.span.start));
+    out
+}
+
+/// The items of a parsed rules file (own items only).
+pub fn own_items(db: &dyn Db, file: SourceFile) -> &[ItemNode] {
+    &parsed_rules(db, file).items
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn load(db: &mut Database, path: &str) -> SourceFile {
+        let full = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("..")
+            .join(path);
+        let text = std::fs::read_to_string(&full).unwrap();
+        db.set_file(&normalize(std::path::Path::new(path)), text)
+    }
+
+    fn errors(db: &Database, f: SourceFile) -> Vec<String> {
+        let sources = db.sources();
+        rules_diagnostics(db, f)
+            .iter()
+            .map(|d| crate::render::to_short(d, &sources))
+            .collect()
+    }
+
+    #[test]
+    fn the_design_examples_check_clean() {
+        for dir in ["examples/ariac", "examples/p3_assembler"] {
+            let mut db = Database::new();
+            load(&mut db, &format!("{dir}/domain.pddl"));
+            load(&mut db, &format!("{dir}/problem.pddl"));
+            let rules = load(&mut db, &format!("{dir}/rules.btrules"));
+            assert_eq!(errors(&db, rules), Vec::<String>::new(), "{dir}");
+        }
+    }
+
+    #[test]
+    fn editing_one_rule_rechecks_only_that_rule() {
+        let mut db = Database::new();
+        load(&mut db, "examples/ariac/domain.pddl");
+        let f = load(&mut db, "lang/tests/fixtures/large.btrules");
+        let items = rules_items(&db, f).len();
+        assert!(items > 700);
+        assert!(
+            errors(&db, f).iter().all(|e| e.contains("R013")),
+            "{:?}",
+            &errors(&db, f)[..3]
+        );
+        db.start_logging();
+        // Change one rule in the middle, and the text's length with it.
+        let text = f.text(&db).replacen(
+            "retry(3) MoveTo(robot: ?r, target: ?b)",
+            "retry(30) MoveTo(robot: ?r, target: ?destination)",
+            1,
+        );
+        db.set_file(f.path(&db).clone().as_str(), text);
+        let after = errors(&db, f);
+        let log = db.take_log();
+        let rechecked = log
+            .iter()
+            .filter(|l| l.starts_with("item_diagnostics"))
+            .count();
+        assert_eq!(rechecked, 1, "{log:#?}");
+        assert_eq!(after.len(), 1, "{after:?}");
+        assert!(
+            after[0].ends_with(":27:45: error[R006]: `?destination` is not bound here"),
+            "{after:?}"
+        );
+    }
+
+    #[test]
+    fn an_unknown_stdlib_module_and_import_cycles() {
+        let mut db = Database::new();
+        db.set_file(
+            "a.btrules",
+            "import \"b.btrules\"\nimport std::nope\naction A()\n".into(),
+        );
+        db.set_file("b.btrules", "import \"a.btrules\"\naction B()\n".into());
+        let a = db.file("a.btrules").unwrap();
+        let codes: Vec<&str> = rules_diagnostics(&db, a).iter().map(|d| d.code).collect();
+        assert!(codes.contains(&"R018"));
+        assert!(declarations(&db, a).nodes.contains_key("B"));
+    }
+}
