@@ -554,3 +554,137 @@ mod tests {
         assert!(declarations(&db, a).nodes.contains_key("B"));
     }
 }
+
+/// What `btc compile` is asked: a rules file and a plan, with the problem
+/// and domain when they are not named in the rules file.
+#[salsa::input(debug)]
+pub struct CompileJob {
+    #[returns(copy)]
+    pub rules: SourceFile,
+    #[returns(copy)]
+    pub plan: SourceFile,
+    #[returns(copy)]
+    pub problem: Option<SourceFile>,
+    #[returns(copy)]
+    pub domain: Option<SourceFile>,
+}
+
+/// The domain a job uses: given explicitly, or named by the rules file.
+pub fn job_domain(db: &dyn Db, job: CompileJob) -> Option<SourceFile> {
+    job.domain(db).or_else(|| domain_file(db, job.rules(db)))
+}
+
+pub fn job_problem(db: &dyn Db, job: CompileJob) -> Option<SourceFile> {
+    job.problem(db).or_else(|| problem_file(db, job.rules(db)))
+}
+
+/// Every diagnostic a compile job raises before lowering (rules, imports,
+/// domain, problem, plan), sorted by file and position.
+#[salsa::tracked(returns(ref))]
+pub fn job_diagnostics(db: &dyn Db, job: CompileJob) -> Vec<Diagnostic> {
+    let rules = job.rules(db);
+    let mut out: Vec<Diagnostic> = rules_diagnostics(db, rules).clone();
+    let Some(d) = job_domain(db, job) else {
+        if declared_path(db, rules, false).is_none() {
+            // rules_diagnostics reported the missing `domain` already.
+        }
+        return out;
+    };
+    out.extend(checked_domain(db, d).diagnostics.iter().cloned());
+    let Some(p) = job_problem(db, job) else {
+        out.push(
+            Diagnostic::error(
+                codes::R_NO_DOMAIN,
+                Span::new(file_id(db, job.plan(db)), 0, 0),
+                "compiling a plan needs the PDDL problem it solves",
+            )
+            .with_hint(
+                "pass `--problem FILE`, or add `problem \"problem.pddl\"` to the rules file",
+            ),
+        );
+        return out;
+    };
+    out.extend(
+        checked_problem(db, ProblemOf::new(db, p, d))
+            .diagnostics
+            .iter()
+            .cloned(),
+    );
+    out.extend(typed_plan(db, job).diagnostics.iter().cloned());
+    out
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct TypedPlan {
+    pub plan: crate::plan::Plan,
+    pub steps: Vec<crate::plan::GroundStep>,
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+#[salsa::tracked(returns(ref))]
+pub fn typed_plan(db: &dyn Db, job: CompileJob) -> TypedPlan {
+    let pf = job.plan(db);
+    let (plan, mut diagnostics) = crate::plan::parse_plan(pf.text(db), file_id(db, pf));
+    let mut steps = Vec::new();
+    if let (Some(d), Some(p)) = (job_domain(db, job), job_problem(db, job)) {
+        let cd = checked_domain(db, d);
+        let cp = checked_problem(db, ProblemOf::new(db, p, d));
+        if let Some(domain) = &cd.domain {
+            let (s, diags) = crate::plan::type_plan(&plan, domain, &cd.index, &cp.index);
+            steps = s;
+            diagnostics.extend(diags);
+        }
+    }
+    TypedPlan {
+        plan,
+        steps,
+        diagnostics,
+    }
+}
+
+/// Compiles a job to the tree IR, or returns why not (errors only; see
+/// [`job_diagnostics`] for warnings).
+#[salsa::tracked(returns(ref))]
+pub fn compile(db: &dyn Db, job: CompileJob) -> Result<crate::ir::TreeIr, Vec<Diagnostic>> {
+    let diags = job_diagnostics(db, job);
+    if crate::diagnostic::has_errors(diags) {
+        return Err(diags.iter().filter(|d| d.is_error()).cloned().collect());
+    }
+    let rules = job.rules(db);
+    let (Some(d), Some(p)) = (job_domain(db, job), job_problem(db, job)) else {
+        return Err(Vec::new());
+    };
+    let cd = checked_domain(db, d);
+    let cp = checked_problem(db, ProblemOf::new(db, p, d));
+    let (Some(domain), Some(problem)) = (&cd.domain, &cp.problem) else {
+        return Err(Vec::new());
+    };
+    let tp = typed_plan(db, job);
+    let mut all_rules = Vec::new();
+    let mut plan_template = None;
+    for f in &import_closure(db, rules).0 {
+        for n in &parsed_rules(db, *f).items {
+            match &n.item {
+                Item::Rule(r) => all_rules.push(r),
+                Item::Plan { body, .. } if *f == rules && plan_template.is_none() => {
+                    plan_template = Some(body.as_slice())
+                }
+                _ => {}
+            }
+        }
+    }
+    let input = crate::lower::LowerInput {
+        decls: declarations(db, rules),
+        rules: all_rules,
+        plan_template,
+        domain,
+        dix: &cd.index,
+        problem,
+        pix: &cp.index,
+        plan: &tp.plan,
+        steps: &tp.steps,
+        domain_path: d.path(db).clone(),
+        problem_path: p.path(db).clone(),
+    };
+    crate::lower::lower(&input)
+}

@@ -8,6 +8,9 @@
 
 pub mod db;
 pub mod diagnostic;
+pub mod emit;
+pub mod ir;
+pub mod lower;
 pub mod pddl;
 pub mod pipeline;
 pub mod plan;

@@ -1,13 +1,13 @@
 //! Source files, spans and decoding of raw bytes into text.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// Index of a file in a [`Sources`] set.
 pub type FileId = u32;
 
 /// A byte range in one source file. Byte offsets everywhere; editors' UTF-16
 /// columns are computed only at the LSP boundary.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub struct Span {
     pub file: FileId,
     pub start: u32,

@@ -2,9 +2,9 @@
 //! lower-case (PDDL is case-insensitive); spans point at the text as written.
 
 use crate::source::Span;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
-#[derive(Clone, Debug, PartialEq, Eq, Hash, Serialize)]
+#[derive(Clone, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub struct Name {
     pub name: String,
     pub span: Span,
@@ -17,7 +17,7 @@ impl Name {
 }
 
 /// The type after `-` in a typed list. `object` when none is written.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "lowercase")]
 pub enum TypeSpec {
     Object,
@@ -54,13 +54,13 @@ impl std::fmt::Display for TypeSpec {
 
 /// `name - type`: a type declaration, a constant, an object or a parameter
 /// (for parameters `name` is the variable without `?`).
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Typed {
     pub name: Name,
     pub ty: TypeSpec,
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "lowercase")]
 pub enum Term {
     Var { name: Name },
@@ -85,7 +85,7 @@ impl std::fmt::Display for Term {
 }
 
 /// `(pred t1 t2 ...)`, also used for function applications `(f t1 ...)`.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Atom {
     pub pred: Name,
     pub args: Vec<Term>,
@@ -102,7 +102,7 @@ impl std::fmt::Display for Atom {
     }
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Comparison {
     Lt,
@@ -112,7 +112,7 @@ pub enum Comparison {
     Eq,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum NumOp {
     Add,
@@ -121,7 +121,7 @@ pub enum NumOp {
     Div,
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "lowercase")]
 pub enum NumExpr {
     Number {
@@ -147,7 +147,7 @@ pub enum NumExpr {
     },
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "lowercase")]
 pub enum Formula {
     Atom {
@@ -217,7 +217,7 @@ impl Formula {
     }
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum AssignOp {
     Assign,
@@ -227,7 +227,7 @@ pub enum AssignOp {
     ScaleDown,
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "lowercase")]
 pub enum Effect {
     Add {
@@ -279,14 +279,14 @@ impl Effect {
     }
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PredicateDecl {
     pub name: Name,
     pub params: Vec<Typed>,
     pub span: Span,
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FunctionDecl {
     pub name: Name,
     pub params: Vec<Typed>,
@@ -296,7 +296,7 @@ pub struct FunctionDecl {
 }
 
 /// A duration constraint `(= ?duration expr)`; inequalities are refused.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Duration {
     pub value: NumExpr,
     pub span: Span,
@@ -305,7 +305,7 @@ pub struct Duration {
 /// Conditions and effects split by when they apply. A plain `:action` has
 /// only `at_start` conditions and `at_end` effects: its precondition is
 /// checked when it starts and its effect applies when it ends.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Action {
     pub name: Name,
     pub params: Vec<Typed>,
@@ -319,14 +319,14 @@ pub struct Action {
     pub span: Span,
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Derived {
     pub head: PredicateDecl,
     pub body: Formula,
     pub span: Span,
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Domain {
     pub name: Name,
     pub requirements: Vec<Name>,
@@ -340,7 +340,7 @@ pub struct Domain {
 }
 
 /// A fact of `:init`.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "lowercase")]
 pub enum InitFact {
     Atom {
@@ -354,21 +354,21 @@ pub enum InitFact {
     },
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Optimize {
     Minimize,
     Maximize,
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Metric {
     pub optimize: Optimize,
     pub expr: NumExpr,
     pub span: Span,
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Problem {
     pub name: Name,
     pub domain: Name,

@@ -4,16 +4,16 @@
 
 use crate::pddl::ast::{Effect, Formula};
 use crate::source::Span;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// A name as written (case kept: node names are CamelCase).
-#[derive(Clone, Debug, PartialEq, Eq, Hash, Serialize)]
+#[derive(Clone, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub struct Ident {
     pub text: String,
     pub span: Span,
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "lowercase")]
 pub enum StrPart {
     Text {
@@ -30,7 +30,7 @@ pub enum StrPart {
 }
 
 /// A string literal, split at its `{...}` interpolations.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct StrLit {
     pub parts: Vec<StrPart>,
     pub span: Span,
@@ -50,21 +50,21 @@ impl StrLit {
     }
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "lowercase")]
 pub enum ImportTarget {
     Path { path: StrLit },
     Std { module: Ident },
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum NodeKind {
     Action,
     Condition,
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PortDecl {
     pub out: bool,
     pub name: Ident,
@@ -73,7 +73,7 @@ pub struct PortDecl {
     pub span: Span,
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct NodeDecl {
     pub kind: NodeKind,
     pub name: Ident,
@@ -83,7 +83,7 @@ pub struct NodeDecl {
     pub span: Span,
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TreeDecl {
     pub name: Ident,
     pub ports: Vec<PortDecl>,
@@ -91,7 +91,7 @@ pub struct TreeDecl {
     pub span: Span,
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "lowercase")]
 pub enum Literal {
     Int { value: i64, span: Span },
@@ -113,13 +113,13 @@ impl Literal {
     }
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TableEntry {
     pub key: Ident,
     pub value: Literal,
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TableDecl {
     pub name: Ident,
     pub entries: Vec<TableEntry>,
@@ -128,14 +128,14 @@ pub struct TableDecl {
 
 /// One piece of a rule's action-name pattern: `PICK_{op}` is
 /// `[Lit("PICK_"), Capture("op")]`.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "lowercase")]
 pub enum NamePart {
     Lit { text: String, span: Span },
     Capture { name: Ident },
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Param {
     /// Variable name without `?`, lower-cased (PDDL is case-insensitive).
     pub var: Ident,
@@ -144,7 +144,7 @@ pub struct Param {
     pub span: Span,
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Pattern {
     pub name: Vec<NamePart>,
     pub params: Vec<Param>,
@@ -185,7 +185,7 @@ fn part_span(p: &NamePart) -> Span {
     }
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "kebab-case")]
 pub enum Guard {
     Ne {
@@ -219,7 +219,7 @@ impl Guard {
     }
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "lowercase")]
 pub enum RuleBody {
     Skip {
@@ -231,7 +231,7 @@ pub enum RuleBody {
     },
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Rule {
     pub pattern: Pattern,
     pub guards: Vec<Guard>,
@@ -239,7 +239,7 @@ pub struct Rule {
     pub span: Span,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "kebab-case")]
 pub enum ControlKind {
     Sequence,
@@ -261,7 +261,7 @@ impl ControlKind {
     }
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "kebab-case")]
 pub enum DecoratorKind {
     Retry { times: u32 },
@@ -285,7 +285,7 @@ impl DecoratorKind {
     }
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum StepsMode {
     InOrder,
@@ -293,7 +293,7 @@ pub enum StepsMode {
     Backchained,
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "lowercase")]
 pub enum Value {
     Var {
@@ -339,13 +339,13 @@ impl Value {
     }
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Arg {
     pub port: Ident,
     pub value: Value,
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "lowercase")]
 pub enum Template {
     Control {
@@ -387,7 +387,7 @@ impl Template {
     }
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "lowercase")]
 pub enum Item {
     Domain {
@@ -433,7 +433,7 @@ impl Item {
 }
 
 /// A top-level item with its place in the file.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ItemNode {
     /// Byte offset of the item's first token; the item's spans are relative to it.
     pub offset: u32,

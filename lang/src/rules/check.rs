@@ -452,12 +452,11 @@ impl Tcx<'_> {
                                     .collect::<Vec<_>>()
                             })
                             .unwrap_or_default();
-                        let hint = did_you_mean(&obj_l, known.iter().copied()).unwrap_or_else(
-                            || {
+                        let hint =
+                            did_you_mean(&obj_l, known.iter().copied()).unwrap_or_else(|| {
                                 "it names no object of the problem and no constant of the domain"
                                     .to_owned()
-                            },
-                        );
+                            });
                         self.err(
                             Diagnostic::error(codes::R_UNKNOWN_OBJECT, value.span(), format!("`{obj}` is not among the problem's objects or the domain's constants"))
                                 .with_hint(hint),

@@ -1,0 +1,285 @@
+//! The tree IR: what a compiled plan is, independent of any output format.
+//! Emitters and the runtime read it; it round-trips through JSON.
+//!
+//! A step's subtree is a call of the rule's parametric tree (a BT.CPP
+//! `<SubTree>` with port remapping); [`TreeIr::inlined`] expands every call
+//! for formats and engines that want one flat tree.
+
+use crate::rules::ast::{ControlKind, DecoratorKind};
+use serde::{Deserialize, Serialize};
+
+pub const IR_VERSION: u32 = 1;
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", content = "value", rename_all = "lowercase")]
+pub enum PortValue {
+    Text(String),
+    Int(i64),
+    Float(f64),
+    Bool(bool),
+    /// A port of the enclosing tree (`{name}` in BT.CPP).
+    Param(String),
+}
+
+impl PortValue {
+    /// The value as BT.CPP writes it in an attribute.
+    pub fn to_text(&self) -> String {
+        match self {
+            PortValue::Text(s) => s.clone(),
+            PortValue::Int(n) => n.to_string(),
+            PortValue::Float(f) => format_float(*f),
+            PortValue::Bool(b) => b.to_string(),
+            PortValue::Param(p) => format!("{{{p}}}"),
+        }
+    }
+}
+
+/// Floats always with a decimal point (`1.0`, not `1`).
+pub fn format_float(f: f64) -> String {
+    if f.fract() == 0.0 && f.is_finite() && f.abs() < 1e15 {
+        format!("{f:.1}")
+    } else {
+        format!("{f}")
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Port {
+    pub name: String,
+    pub value: PortValue,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LeafKind {
+    Action,
+    Condition,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "node", rename_all = "lowercase")]
+pub enum Node {
+    Control {
+        control: ControlKind,
+        name: Option<String>,
+        children: Vec<Node>,
+    },
+    Decorator {
+        decorator: DecoratorKind,
+        name: Option<String>,
+        child: Box<Node>,
+    },
+    Leaf {
+        leaf: LeafKind,
+        id: String,
+        name: Option<String>,
+        ports: Vec<Port>,
+    },
+    /// A call of a [`TreeDef`].
+    SubTree { id: String, ports: Vec<Port> },
+    /// The boundary of plan step `step` (0-based): its at-start effects apply
+    /// when it starts, its at-end effects when `child` succeeds.
+    Step { step: usize, child: Box<Node> },
+}
+
+impl Node {
+    pub fn sequence(children: Vec<Node>) -> Node {
+        Node::Control {
+            control: ControlKind::Sequence,
+            name: None,
+            children,
+        }
+    }
+
+    /// Calls `f` on this node and every node below it (not into subtrees).
+    pub fn walk<'a>(&'a self, f: &mut impl FnMut(&'a Node)) {
+        f(self);
+        match self {
+            Node::Control { children, .. } => children.iter().for_each(|c| c.walk(f)),
+            Node::Decorator { child, .. } | Node::Step { child, .. } => child.walk(f),
+            Node::Leaf { .. } | Node::SubTree { .. } => {}
+        }
+    }
+}
+
+/// A parametric tree: a rule's template, or a `tree` declaration.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TreeDef {
+    pub id: String,
+    pub params: Vec<String>,
+    pub root: Node,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum PortDirection {
+    Input,
+    Output,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PortModel {
+    pub name: String,
+    pub direction: PortDirection,
+    /// A PDDL type, or string / int / float / bool.
+    pub ty: String,
+}
+
+/// A leaf node type the tree uses, with its ports (BT.CPP's TreeNodesModel).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct NodeModel {
+    pub id: String,
+    pub kind: LeafKind,
+    pub ports: Vec<PortModel>,
+    /// For a condition defined by a formula: PDDL text over `?port` variables.
+    pub formula: Option<String>,
+}
+
+/// One plan step as compiled.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StepInfo {
+    pub index: usize,
+    /// 1-based line in the plan file.
+    pub line: u32,
+    pub action: String,
+    pub args: Vec<String>,
+    pub time: Option<f64>,
+    pub duration: Option<f64>,
+    /// The id of the rule tree it calls; `None` for a skipped step.
+    pub rule: Option<String>,
+    pub skipped: bool,
+    /// Ground PDDL conditions and effects, by when they apply.
+    pub pre_start: Option<String>,
+    pub pre_over_all: Option<String>,
+    pub pre_end: Option<String>,
+    pub eff_start: Option<String>,
+    pub eff_end: Option<String>,
+    /// Steps that must finish before this one (`steps parallel`).
+    pub after: Vec<usize>,
+}
+
+impl StepInfo {
+    /// `(action arg ...)`
+    pub fn display(&self) -> String {
+        let mut s = format!("({}", self.action);
+        for a in &self.args {
+            s.push(' ');
+            s.push_str(a);
+        }
+        s.push(')');
+        s
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TreeIr {
+    pub version: u32,
+    pub domain: String,
+    pub problem: String,
+    pub main_tree: String,
+    pub root: Node,
+    pub trees: Vec<TreeDef>,
+    pub nodes: Vec<NodeModel>,
+    pub steps: Vec<StepInfo>,
+    /// The problem's objects (and the domain's constants) with their type.
+    pub objects: Vec<(String, String)>,
+    /// The problem's initial facts, e.g. `(on battery_red bin1)`.
+    pub init: Vec<String>,
+    pub goal: Option<String>,
+}
+
+/// Deepest chain of subtree calls [`TreeIr::inlined`] expands.
+pub const MAX_CALL_DEPTH: usize = 32;
+
+impl TreeIr {
+    pub fn tree(&self, id: &str) -> Option<&TreeDef> {
+        self.trees.iter().find(|t| t.id == id)
+    }
+
+    pub fn node_model(&self, id: &str) -> Option<&NodeModel> {
+        self.nodes.iter().find(|n| n.id == id)
+    }
+
+    /// The main tree with every subtree call expanded.
+    pub fn inlined(&self) -> Node {
+        self.inline_node(&self.root, &[], 0)
+    }
+
+    fn inline_node(&self, n: &Node, args: &[Port], depth: usize) -> Node {
+        let subst = |ports: &[Port]| -> Vec<Port> {
+            ports
+                .iter()
+                .map(|p| Port {
+                    name: p.name.clone(),
+                    value: substitute(&p.value, args),
+                })
+                .collect()
+        };
+        match n {
+            Node::Control {
+                control,
+                name,
+                children,
+            } => Node::Control {
+                control: *control,
+                name: name.as_ref().map(|s| interpolate(s, args)),
+                children: children
+                    .iter()
+                    .map(|c| self.inline_node(c, args, depth))
+                    .collect(),
+            },
+            Node::Decorator {
+                decorator,
+                name,
+                child,
+            } => Node::Decorator {
+                decorator: *decorator,
+                name: name.as_ref().map(|s| interpolate(s, args)),
+                child: Box::new(self.inline_node(child, args, depth)),
+            },
+            Node::Leaf {
+                leaf,
+                id,
+                name,
+                ports,
+            } => Node::Leaf {
+                leaf: *leaf,
+                id: id.clone(),
+                name: name.as_ref().map(|s| interpolate(s, args)),
+                ports: subst(ports),
+            },
+            Node::Step { step, child } => Node::Step {
+                step: *step,
+                child: Box::new(self.inline_node(child, args, depth)),
+            },
+            Node::SubTree { id, ports } => match self.tree(id) {
+                Some(def) if depth < MAX_CALL_DEPTH => {
+                    self.inline_node(&def.root, &subst(ports), depth + 1)
+                }
+                _ => Node::SubTree {
+                    id: id.clone(),
+                    ports: subst(ports),
+                },
+            },
+        }
+    }
+}
+
+fn substitute(v: &PortValue, args: &[Port]) -> PortValue {
+    match v {
+        PortValue::Param(p) => args
+            .iter()
+            .find(|a| a.name == *p)
+            .map_or_else(|| v.clone(), |a| a.value.clone()),
+        other => other.clone(),
+    }
+}
+
+/// Fills `{param}` in a node name from the call's arguments.
+fn interpolate(s: &str, args: &[Port]) -> String {
+    let mut out = s.to_owned();
+    for a in args {
+        out = out.replace(&format!("{{{}}}", a.name), &a.value.to_text());
+    }
+    out
+}

@@ -1,0 +1,1141 @@
+//! Lowering: rules + a typed plan -> [`TreeIr`]. Each step is matched
+//! against the rules (first match in file order), the rule's template
+//! becomes a parametric tree called with the step's bindings, KB effects
+//! and conditions are attached, and the `plan { ... }` template arranges the
+//! steps (`steps`, `steps backchained`, `steps parallel`).
+
+use crate::diagnostic::{codes, Diagnostic};
+use crate::ir::*;
+use crate::pddl::ast::{Action, Domain, Effect, Formula, Problem, Term};
+use crate::pddl::check::{DomainIndex, ProblemIndex};
+use crate::plan::{GroundStep, Plan};
+use crate::rules::ast::*;
+use crate::rules::check::Decls;
+use crate::rules::matching::{match_name, match_step, Bindings, Captures, ObjectTypes};
+use std::collections::{BTreeMap, BTreeSet};
+
+pub struct LowerInput<'a> {
+    pub decls: &'a Decls,
+    /// Rules in match order (the file's own first, then imported ones).
+    pub rules: Vec<&'a Rule>,
+    pub plan_template: Option<&'a [Template]>,
+    pub domain: &'a Domain,
+    pub dix: &'a DomainIndex,
+    pub problem: &'a Problem,
+    pub pix: &'a ProblemIndex,
+    pub plan: &'a Plan,
+    pub steps: &'a [GroundStep],
+    pub domain_path: String,
+    pub problem_path: String,
+}
+
+struct Types<'a> {
+    dix: &'a DomainIndex,
+    pix: &'a ProblemIndex,
+}
+
+impl ObjectTypes for Types<'_> {
+    fn object_is(&self, object: &str, ty: &str) -> bool {
+        match (self.pix.objects.get(object), self.dix.types.id(ty)) {
+            (Some(o), Some(t)) => self.dix.types.fits(&o.types, &[t]),
+            _ => false,
+        }
+    }
+}
+
+/// A PDDL formula or effect with its action's parameters cut out, so a step's
+/// ground text is a concatenation instead of a fresh formatting.
+#[derive(Clone, Debug)]
+struct Spliced(Vec<Seg>);
+
+#[derive(Clone, Debug)]
+enum Seg {
+    Lit(String),
+    Arg(usize),
+}
+
+const MARK: char = '\u{1}';
+
+impl Spliced {
+    fn new(text: &str) -> Spliced {
+        let mut segs = Vec::new();
+        for (i, part) in text.split(MARK).enumerate() {
+            if i % 2 == 0 {
+                if !part.is_empty() {
+                    segs.push(Seg::Lit(part.to_owned()));
+                }
+            } else {
+                segs.push(Seg::Arg(part.parse().expect("marker holds an index")));
+            }
+        }
+        Spliced(segs)
+    }
+
+    fn ground(&self, args: &[String]) -> String {
+        let mut s = String::new();
+        for seg in &self.0 {
+            match seg {
+                Seg::Lit(l) => s.push_str(l),
+                Seg::Arg(i) => s.push_str(&args[*i]),
+            }
+        }
+        s
+    }
+}
+
+/// Replaces an action's parameters by markers in a formula or effect.
+fn mark_params<T: Clone + serde::Serialize + serde::de::DeserializeOwned>(
+    x: &T,
+    action: &Action,
+) -> T {
+    // Through JSON: one generic walk over every `Term::Var`.
+    let mut v = serde_json::to_value(x).expect("model serializes");
+    fn walk(v: &mut serde_json::Value, action: &Action) {
+        match v {
+            serde_json::Value::Object(m) => {
+                if m.get("kind").and_then(|k| k.as_str()) == Some("var") {
+                    if let Some(name) = m
+                        .get("name")
+                        .and_then(|n| n.get("name"))
+                        .and_then(|n| n.as_str())
+                    {
+                        if let Some(i) = action.params.iter().position(|p| p.name.name == name) {
+                            m.insert("kind".into(), "const".into());
+                            m["name"]["name"] = format!("{MARK}{i}{MARK}").into();
+                        }
+                    }
+                }
+                m.values_mut().for_each(|x| walk(x, action));
+            }
+            serde_json::Value::Array(a) => a.iter_mut().for_each(|x| walk(x, action)),
+            _ => {}
+        }
+    }
+    walk(&mut v, action);
+    serde_json::from_value(v).expect("same shape")
+}
+
+fn conj(parts: &[Formula]) -> Option<String> {
+    (!parts.is_empty()).then(|| crate::pddl::print::conjunction(parts))
+}
+
+fn effs(parts: &[Effect]) -> Option<String> {
+    let non_empty: Vec<&Effect> = parts
+        .iter()
+        .filter(|e| !matches!(e, Effect::And { parts, .. } if parts.is_empty()))
+        .collect();
+    match non_empty.as_slice() {
+        [] => None,
+        [one] => Some(one.to_string()),
+        many => Some(format!(
+            "(and {})",
+            many.iter()
+                .map(|e| e.to_string())
+                .collect::<Vec<_>>()
+                .join(" ")
+        )),
+    }
+}
+
+/// An action's conditions and effects, ready to be grounded.
+struct ActionTexts {
+    pre_start: Option<Spliced>,
+    pre_over_all: Option<Spliced>,
+    pre_end: Option<Spliced>,
+    eff_start: Option<Spliced>,
+    eff_end: Option<Spliced>,
+    /// Effects as a condition ("already done"), for `steps backchained`.
+    done: Option<Spliced>,
+    /// Literals (positive?, predicate, arg slots) when conditions and effects
+    /// are plain conjunctions; `None` otherwise (ordered conservatively).
+    literals: Option<Literals>,
+}
+
+#[derive(Clone, Debug, Default)]
+struct Literals {
+    pre: Vec<(bool, String, Vec<Slot>)>,
+    eff: Vec<(bool, String, Vec<Slot>)>,
+}
+
+#[derive(Clone, Debug)]
+enum Slot {
+    Param(usize),
+    Const(String),
+}
+
+fn slots(args: &[Term], action: &Action) -> Option<Vec<Slot>> {
+    args.iter()
+        .map(|t| match t {
+            Term::Var { name } => action
+                .params
+                .iter()
+                .position(|p| p.name.name == name.name)
+                .map(Slot::Param),
+            Term::Const { name } => Some(Slot::Const(name.name.clone())),
+        })
+        .collect()
+}
+
+fn formula_literals(
+    f: &Formula,
+    action: &Action,
+    out: &mut Vec<(bool, String, Vec<Slot>)>,
+) -> Option<()> {
+    match f {
+        Formula::Atom { atom } => {
+            out.push((true, atom.pred.name.clone(), slots(&atom.args, action)?))
+        }
+        Formula::Not { formula, .. } => match &**formula {
+            Formula::Atom { atom } => {
+                out.push((false, atom.pred.name.clone(), slots(&atom.args, action)?))
+            }
+            Formula::Equal { .. } => {}
+            _ => return None,
+        },
+        Formula::And { parts, .. } => {
+            for p in parts {
+                formula_literals(p, action, out)?;
+            }
+        }
+        Formula::Equal { .. } => {}
+        _ => return None,
+    }
+    Some(())
+}
+
+fn effect_literals(
+    e: &Effect,
+    action: &Action,
+    out: &mut Vec<(bool, String, Vec<Slot>)>,
+) -> Option<()> {
+    match e {
+        Effect::Add { atom } => {
+            out.push((true, atom.pred.name.clone(), slots(&atom.args, action)?))
+        }
+        Effect::Delete { atom, .. } => {
+            out.push((false, atom.pred.name.clone(), slots(&atom.args, action)?))
+        }
+        Effect::And { parts, .. } => {
+            for p in parts {
+                effect_literals(p, action, out)?;
+            }
+        }
+        // Action costs never order steps: increases commute.
+        Effect::Numeric { fluent, .. } if fluent.pred.name == "total-cost" => {}
+        _ => return None,
+    }
+    Some(())
+}
+
+impl ActionTexts {
+    fn new(a: &Action) -> ActionTexts {
+        let sp = |t: Option<String>| t.map(|t| Spliced::new(&t));
+        let pre_start: Vec<Formula> = a.pre_start.iter().map(|f| mark_params(f, a)).collect();
+        let over: Vec<Formula> = a.pre_over_all.iter().map(|f| mark_params(f, a)).collect();
+        let pre_end: Vec<Formula> = a.pre_end.iter().map(|f| mark_params(f, a)).collect();
+        let eff_start: Vec<Effect> = a.eff_start.iter().map(|e| mark_params(e, a)).collect();
+        let eff_end: Vec<Effect> = a.eff_end.iter().map(|e| mark_params(e, a)).collect();
+        let mut lits = Literals::default();
+        let simple = a
+            .pre_start
+            .iter()
+            .chain(&a.pre_over_all)
+            .chain(&a.pre_end)
+            .all(|f| formula_literals(f, a, &mut lits.pre).is_some())
+            && a.eff_start
+                .iter()
+                .chain(&a.eff_end)
+                .all(|e| effect_literals(e, a, &mut lits.eff).is_some());
+        // "Already done": the net effect as a condition, when it is plain.
+        let mut net = Vec::new();
+        let done = if eff_start
+            .iter()
+            .chain(&eff_end)
+            .all(|e| effect_literals(e, a, &mut net).is_some())
+            && !net.is_empty()
+        {
+            let mut marked_net = Vec::new();
+            for e in eff_start.iter().chain(&eff_end) {
+                collect_marked(e, &mut marked_net);
+            }
+            // A later literal on the same atom wins (add after delete).
+            let mut last: Vec<(bool, String)> = Vec::new();
+            for (pos, atom) in marked_net {
+                last.retain(|(_, a)| *a != atom);
+                last.push((pos, atom));
+            }
+            let parts: Vec<String> = last
+                .into_iter()
+                .map(|(pos, atom)| if pos { atom } else { format!("(not {atom})") })
+                .collect();
+            Some(if parts.len() == 1 {
+                parts[0].clone()
+            } else {
+                format!("(and {})", parts.join(" "))
+            })
+        } else {
+            None
+        };
+        ActionTexts {
+            pre_start: sp(conj(&pre_start)),
+            pre_over_all: sp(conj(&over)),
+            pre_end: sp(conj(&pre_end)),
+            eff_start: sp(effs(&eff_start)),
+            eff_end: sp(effs(&eff_end)),
+            done: sp(done),
+            literals: simple.then_some(lits),
+        }
+    }
+}
+
+fn collect_marked(e: &Effect, out: &mut Vec<(bool, String)>) {
+    match e {
+        Effect::Add { atom } => out.push((true, atom.to_string())),
+        Effect::Delete { atom, .. } => out.push((false, atom.to_string())),
+        Effect::And { parts, .. } => parts.iter().for_each(|p| collect_marked(p, out)),
+        _ => {}
+    }
+}
+
+/// A rule's template made parametric: its tree and, per parameter, the
+/// value expression a call evaluates.
+struct RuleTree {
+    id: String,
+    params: Vec<(String, Value)>,
+    root: Node,
+}
+
+/// Instantiates templates, either with a step's bindings (values filled in)
+/// or parametrically (values that depend on the step become `{param}`s).
+struct Inst<'a> {
+    decls: &'a Decls,
+    bindings: &'a Bindings,
+    captures: &'a Captures,
+    /// Parametric mode: collected parameters.
+    params: Option<Vec<(String, Value)>>,
+    /// Tree ports in scope (inside a `tree` declaration).
+    tree_ports: Vec<String>,
+    used_nodes: BTreeSet<String>,
+    used_trees: BTreeSet<String>,
+}
+
+impl Inst<'_> {
+    fn lookup_var(&self, v: &str) -> Option<&str> {
+        self.bindings
+            .iter()
+            .find(|(n, _)| n == v)
+            .map(|(_, o)| o.as_str())
+    }
+
+    fn lookup_capture(&self, c: &str) -> Option<&str> {
+        self.captures
+            .iter()
+            .find(|(n, _)| n == c)
+            .map(|(_, v)| v.as_str())
+    }
+
+    /// Parametric mode: the parameter standing for this value.
+    fn param_for(&mut self, v: &Value, preferred: &str) -> PortValue {
+        let params = self.params.as_mut().expect("parametric mode");
+        if let Some((name, _)) = params.iter().find(|(_, e)| e == v) {
+            return PortValue::Param(name.clone());
+        }
+        let mut name = preferred.to_owned();
+        let mut n = 1;
+        while params.iter().any(|(p, _)| *p == name) {
+            n += 1;
+            name = format!("{preferred}_{n}");
+        }
+        params.push((name.clone(), v.clone()));
+        PortValue::Param(name)
+    }
+
+    fn depends_on_step(v: &Value) -> bool {
+        match v {
+            Value::Var { .. } | Value::Name { .. } => true,
+            Value::Str { value } => value.plain().is_none(),
+            Value::Lookup { key, .. } => Self::depends_on_step(key),
+            _ => false,
+        }
+    }
+
+    fn value(&mut self, v: &Value) -> PortValue {
+        if self.tree_ports.is_empty() && self.params.is_some() && Self::depends_on_step(v) {
+            let preferred = match v {
+                Value::Var { name } | Value::Name { name } => name.text.clone(),
+                _ => "value".to_owned(),
+            };
+            return self.param_for(v, &preferred);
+        }
+        self.eval(v)
+    }
+
+    /// A value with the step's bindings (or tree ports) filled in.
+    fn eval(&self, v: &Value) -> PortValue {
+        match v {
+            Value::Var { name } => {
+                if self.tree_ports.contains(&name.text) {
+                    return PortValue::Param(name.text.clone());
+                }
+                PortValue::Text(self.lookup_var(&name.text).unwrap_or_default().to_owned())
+            }
+            Value::Name { name } => PortValue::Text(
+                self.lookup_capture(&name.text)
+                    .unwrap_or(&name.text)
+                    .to_uppercase(),
+            ),
+            Value::Str { value } => PortValue::Text(self.string(value)),
+            Value::Int { value, .. } => PortValue::Int(*value),
+            Value::Float { value, .. } => PortValue::Float(*value),
+            Value::Bool { value, .. } => PortValue::Bool(*value),
+            Value::Lookup { table, key, .. } => {
+                let key = match self.eval(key) {
+                    PortValue::Text(t) => t,
+                    other => other.to_text(),
+                };
+                let entry = self.decls.tables.get(&table.text).and_then(|t| {
+                    t.entries
+                        .iter()
+                        .find(|e| e.key.text.eq_ignore_ascii_case(&key))
+                });
+                match entry.map(|e| &e.value) {
+                    Some(Literal::Int { value, .. }) => PortValue::Int(*value),
+                    Some(Literal::Float { value, .. }) => PortValue::Float(*value),
+                    Some(Literal::Bool { value, .. }) => PortValue::Bool(*value),
+                    Some(Literal::Str { value }) => PortValue::Text(self.string(value)),
+                    Some(Literal::Name { name }) => PortValue::Text(name.text.clone()),
+                    None => PortValue::Text(String::new()),
+                }
+            }
+        }
+    }
+
+    fn string(&self, s: &StrLit) -> String {
+        let mut out = String::new();
+        for p in &s.parts {
+            match p {
+                StrPart::Text { text } => out.push_str(text),
+                StrPart::Var { name } => match self.lookup_var(&name.text) {
+                    Some(o) if self.params.is_none() || !self.tree_ports.is_empty() => {
+                        out.push_str(o)
+                    }
+                    _ => {
+                        out.push('{');
+                        out.push_str(&name.text);
+                        out.push('}');
+                    }
+                },
+                StrPart::Capture { name } => match self.lookup_capture(&name.text) {
+                    Some(c) if self.params.is_none() => out.push_str(&c.to_uppercase()),
+                    _ => {
+                        out.push('{');
+                        out.push_str(&name.text);
+                        out.push('}');
+                    }
+                },
+            }
+        }
+        out
+    }
+
+    /// A node name: interpolations become `{param}` in parametric mode (the
+    /// inliner fills them), values otherwise.
+    fn name(&mut self, s: &Option<StrLit>) -> Option<String> {
+        let s = s.as_ref()?;
+        if self.params.is_some() && self.tree_ports.is_empty() {
+            for p in &s.parts {
+                match p {
+                    StrPart::Var { name } => {
+                        self.param_for(&Value::Var { name: name.clone() }, &name.text);
+                    }
+                    StrPart::Capture { name } => {
+                        self.param_for(&Value::Name { name: name.clone() }, &name.text);
+                    }
+                    StrPart::Text { .. } => {}
+                }
+            }
+        }
+        Some(self.string(s))
+    }
+
+    fn templates(&mut self, ts: &[Template], steps: &dyn Fn(StepsMode) -> Vec<Node>) -> Vec<Node> {
+        ts.iter().flat_map(|t| self.template(t, steps)).collect()
+    }
+
+    fn template(&mut self, t: &Template, steps: &dyn Fn(StepsMode) -> Vec<Node>) -> Vec<Node> {
+        match t {
+            Template::Control {
+                control,
+                name,
+                children,
+                ..
+            } => {
+                let name = self.name(name);
+                vec![Node::Control {
+                    control: *control,
+                    name,
+                    children: self.templates(children, steps),
+                }]
+            }
+            Template::Decorator {
+                decorator,
+                name,
+                child,
+                ..
+            } => {
+                let name = self.name(name);
+                let mut kids = self.template(child, steps);
+                let child = if kids.len() == 1 {
+                    kids.remove(0)
+                } else {
+                    Node::sequence(kids)
+                };
+                vec![Node::Decorator {
+                    decorator: *decorator,
+                    name,
+                    child: Box::new(child),
+                }]
+            }
+            Template::Call { name, args, .. } => {
+                let ports: Vec<Port> = args
+                    .iter()
+                    .map(|a| Port {
+                        name: a.port.text.clone(),
+                        value: self.value(&a.value),
+                    })
+                    .collect();
+                if self.decls.trees.contains_key(&name.text) {
+                    self.used_trees.insert(name.text.clone());
+                    vec![Node::SubTree {
+                        id: tree_id(&name.text),
+                        ports,
+                    }]
+                } else {
+                    self.used_nodes.insert(name.text.clone());
+                    let leaf = match self.decls.nodes.get(&name.text).map(|n| n.kind) {
+                        Some(NodeKind::Condition) => LeafKind::Condition,
+                        _ => LeafKind::Action,
+                    };
+                    vec![Node::Leaf {
+                        leaf,
+                        id: name.text.clone(),
+                        name: None,
+                        ports,
+                    }]
+                }
+            }
+            Template::Steps { mode, .. } => steps(*mode),
+            Template::Error { .. } => Vec::new(),
+        }
+    }
+}
+
+fn tree_id(name: &str) -> String {
+    format!("tree_{name}")
+}
+
+/// A BT.CPP-safe id for a rule: `rule_PICK_op`.
+fn rule_id(r: &Rule, taken: &BTreeSet<String>) -> String {
+    let base: String = format!("rule_{}", r.pattern.name_text())
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect::<String>()
+        .replace("__", "_")
+        .trim_end_matches('_')
+        .to_owned();
+    let mut id = base.clone();
+    let mut n = 2;
+    while taken.contains(&id) {
+        id = format!("{base}_{n}");
+        n += 1;
+    }
+    id
+}
+
+fn kb_leaf(leaf: LeafKind, id: &str, port: &str, value: String, name: Option<String>) -> Node {
+    Node::Leaf {
+        leaf,
+        id: id.to_owned(),
+        name,
+        ports: vec![Port {
+            name: port.to_owned(),
+            value: PortValue::Text(value),
+        }],
+    }
+}
+
+/// Lowers a plan; every problem is reported at the plan line of its step.
+pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
+    let mut diags = Vec::new();
+    let types = Types {
+        dix: input.dix,
+        pix: input.pix,
+    };
+    let tables = |name: &str| input.decls.tables.get(name).cloned();
+    let mut texts: BTreeMap<usize, ActionTexts> = BTreeMap::new();
+    let mut rule_trees: Vec<(usize, RuleTree)> = Vec::new(); // by rule index
+    let mut taken = BTreeSet::new();
+    let mut used_nodes = BTreeSet::new();
+    let mut used_trees = BTreeSet::new();
+    let mut infos = Vec::with_capacity(input.steps.len());
+    let mut step_nodes: Vec<Option<Node>> = Vec::with_capacity(input.steps.len());
+    let no_bindings = Bindings::new();
+    let no_captures = Captures::new();
+
+    for (k, g) in input.steps.iter().enumerate() {
+        let step = &input.plan.steps[g.step];
+        let action = &input.domain.actions[g.action];
+        let args: Vec<String> = g
+            .args
+            .iter()
+            .map(|&o| input.pix.object_names[o as usize].clone())
+            .collect();
+        let t = texts
+            .entry(g.action)
+            .or_insert_with(|| ActionTexts::new(action));
+        let ground = |s: &Option<Spliced>| s.as_ref().map(|s| s.ground(&args));
+        let mut info = StepInfo {
+            index: k,
+            line: step.line,
+            action: action.name.name.clone(),
+            args: args.clone(),
+            time: step.time,
+            duration: step.duration,
+            rule: None,
+            skipped: false,
+            pre_start: ground(&t.pre_start),
+            pre_over_all: ground(&t.pre_over_all),
+            pre_end: ground(&t.pre_end),
+            eff_start: ground(&t.eff_start),
+            eff_end: ground(&t.eff_end),
+            after: Vec::new(),
+        };
+        let found = input.rules.iter().enumerate().find_map(|(ri, r)| {
+            match_step(r, &action.name.name, &args, &tables, &types).map(|m| (ri, *r, m))
+        });
+        let Some((ri, rule, (captures, bindings))) = found else {
+            let named: Vec<&&Rule> = input
+                .rules
+                .iter()
+                .filter(|r| match_name(&r.pattern.name, &action.name.name).is_some())
+                .collect();
+            let hint = if named.is_empty() {
+                format!(
+                    "add a rule for it: `rule ({} {}) {{ ... }}`",
+                    action.name.name,
+                    action
+                        .params
+                        .iter()
+                        .map(|p| format!("?{}", p.name.name))
+                        .collect::<Vec<_>>()
+                        .join(" ")
+                )
+            } else {
+                format!("{} rule{} for `{}` exist, but their parameter counts or `where` guards do not fit this step", named.len(), if named.len() == 1 { "" } else { "s" }, action.name.name)
+            };
+            diags.push(
+                Diagnostic::error(
+                    codes::R_NO_RULE,
+                    step.span,
+                    format!("step {} `{}`: no rule matches it", k + 1, info.display()),
+                )
+                .with_hint(hint),
+            );
+            infos.push(info);
+            step_nodes.push(None);
+            continue;
+        };
+        let RuleBody::Template { body, .. } = &rule.body else {
+            info.skipped = true;
+            infos.push(info);
+            step_nodes.push(None);
+            continue;
+        };
+        let pos = match rule_trees.iter().position(|(i, _)| *i == ri) {
+            Some(p) => p,
+            None => {
+                let id = rule_id(rule, &taken);
+                taken.insert(id.clone());
+                let mut inst = Inst {
+                    decls: input.decls,
+                    bindings: &no_bindings,
+                    captures: &no_captures,
+                    params: Some(Vec::new()),
+                    tree_ports: Vec::new(),
+                    used_nodes: BTreeSet::new(),
+                    used_trees: BTreeSet::new(),
+                };
+                let mut nodes = inst.templates(body, &|_| Vec::new());
+                let root = if nodes.len() == 1 {
+                    nodes.remove(0)
+                } else {
+                    Node::sequence(nodes)
+                };
+                used_nodes.extend(inst.used_nodes);
+                used_trees.extend(inst.used_trees);
+                rule_trees.push((
+                    ri,
+                    RuleTree {
+                        id,
+                        params: inst.params.unwrap_or_default(),
+                        root,
+                    },
+                ));
+                rule_trees.len() - 1
+            }
+        };
+        let rt = &rule_trees[pos].1;
+        let call_inst = Inst {
+            decls: input.decls,
+            bindings: &bindings,
+            captures: &captures,
+            params: None,
+            tree_ports: Vec::new(),
+            used_nodes: BTreeSet::new(),
+            used_trees: BTreeSet::new(),
+        };
+        let ports: Vec<Port> = rt
+            .params
+            .iter()
+            .map(|(name, expr)| Port {
+                name: name.clone(),
+                value: call_inst.eval(expr),
+            })
+            .collect();
+        // Objects bound to PDDL-typed ports must fit the port's type.
+        check_port_types(
+            &rt.root,
+            &ports,
+            input,
+            &types,
+            &mut |port, node, obj, ty| {
+                diags.push(
+                Diagnostic::error(
+                    codes::R_STEP_TYPE,
+                    step.span,
+                    format!("step {} `{}`: `{obj}` does not fit port `{port}` of `{node}`, which takes a `{ty}`", k + 1, info.display()),
+                )
+                .with_hint("narrow the rule with a guard such as `where ?x - TYPE`, or widen the port's type"),
+            );
+            },
+        );
+        info.rule = Some(rt.id.clone());
+        let mut child = Node::SubTree {
+            id: rt.id.clone(),
+            ports,
+        };
+        if let Some(over) = &info.pre_over_all {
+            child = Node::Control {
+                control: ControlKind::ReactiveSequence,
+                name: Some(format!("while {over}")),
+                children: vec![
+                    kb_leaf(
+                        LeafKind::Condition,
+                        "KbHolds",
+                        "formula",
+                        over.clone(),
+                        None,
+                    ),
+                    child,
+                ],
+            };
+        }
+        step_nodes.push(Some(Node::Step {
+            step: k,
+            child: Box::new(child),
+        }));
+        infos.push(info);
+    }
+    if !diags.is_empty() {
+        return Err(diags);
+    }
+
+    // Parallel mode needs the partial order.
+    let template = input.plan_template;
+    let uses_parallel = template.is_some_and(|t| uses_mode(t, StepsMode::Parallel));
+    if uses_parallel {
+        order_steps(input, &texts, &mut infos);
+    }
+    let mut used_kb = BTreeSet::new();
+    let arranged = |mode: StepsMode| -> Vec<Node> {
+        match mode {
+            StepsMode::InOrder => step_nodes.iter().flatten().cloned().collect(),
+            StepsMode::Backchained => step_nodes
+                .iter()
+                .zip(&infos)
+                .filter_map(|(n, info)| n.clone().map(|n| (n, info)))
+                .map(|(n, info)| {
+                    backchain(n, info, &texts[&input.steps[info.index].action], &info.args)
+                })
+                .collect(),
+            StepsMode::Parallel => vec![parallel(&step_nodes, &infos)],
+        }
+    };
+    let root = match template {
+        Some(t) => {
+            let mut inst = Inst {
+                decls: input.decls,
+                bindings: &no_bindings,
+                captures: &no_captures,
+                params: None,
+                tree_ports: Vec::new(),
+                used_nodes: BTreeSet::new(),
+                used_trees: BTreeSet::new(),
+            };
+            let mut nodes = inst.templates(t, &arranged);
+            used_nodes.extend(inst.used_nodes);
+            used_trees.extend(inst.used_trees);
+            if nodes.len() == 1 {
+                nodes.remove(0)
+            } else {
+                Node::sequence(nodes)
+            }
+        }
+        None => Node::sequence(arranged(StepsMode::InOrder)),
+    };
+    root.walk(&mut |n| {
+        if let Node::Leaf { id, .. } = n {
+            used_kb.insert(id.clone());
+        }
+    });
+    for (_, rt) in &rule_trees {
+        rt.root.walk(&mut |n| {
+            if let Node::Leaf { id, .. } = n {
+                used_kb.insert(id.clone());
+            }
+        });
+    }
+    let mut trees: Vec<TreeDef> = rule_trees
+        .into_iter()
+        .map(|(_, rt)| TreeDef {
+            id: rt.id,
+            params: rt.params.into_iter().map(|(n, _)| n).collect(),
+            root: rt.root,
+        })
+        .collect();
+    // Declared trees, and the trees they call, transitively.
+    let mut pending: Vec<String> = used_trees.iter().cloned().collect();
+    let mut done_trees = BTreeSet::new();
+    while let Some(name) = pending.pop() {
+        if !done_trees.insert(name.clone()) {
+            continue;
+        }
+        let Some(decl) = input.decls.trees.get(&name) else {
+            continue;
+        };
+        let ports: Vec<String> = decl
+            .ports
+            .iter()
+            .map(|p| p.name.text.to_lowercase())
+            .collect();
+        let mut inst = Inst {
+            decls: input.decls,
+            bindings: &no_bindings,
+            captures: &no_captures,
+            params: Some(Vec::new()),
+            tree_ports: ports.clone(),
+            used_nodes: BTreeSet::new(),
+            used_trees: BTreeSet::new(),
+        };
+        let mut nodes = inst.templates(&decl.body, &|_| Vec::new());
+        let root = if nodes.len() == 1 {
+            nodes.remove(0)
+        } else {
+            Node::sequence(nodes)
+        };
+        root.walk(&mut |n| {
+            if let Node::Leaf { id, .. } = n {
+                used_kb.insert(id.clone());
+            }
+        });
+        used_nodes.extend(inst.used_nodes);
+        pending.extend(inst.used_trees);
+        trees.push(TreeDef {
+            id: tree_id(&name),
+            params: decl.ports.iter().map(|p| p.name.text.clone()).collect(),
+            root,
+        });
+    }
+    used_nodes.extend(used_kb);
+    let nodes = node_models(input.decls, &used_nodes);
+    Ok(TreeIr {
+        version: IR_VERSION,
+        domain: input.domain_path.clone(),
+        problem: input.problem_path.clone(),
+        main_tree: "MainTree".into(),
+        root,
+        trees,
+        nodes,
+        steps: infos,
+        objects: input
+            .pix
+            .object_names
+            .iter()
+            .zip(&input.pix.object_types)
+            .map(|(n, t)| (n.clone(), input.dix.types.display(t)))
+            .collect(),
+        init: input
+            .problem
+            .init
+            .iter()
+            .filter_map(|f| match f {
+                crate::pddl::ast::InitFact::Atom { atom } => Some(atom.to_string()),
+                crate::pddl::ast::InitFact::Value { .. } => None,
+            })
+            .collect(),
+        goal: input.problem.goal.as_ref().map(|g| g.to_string()),
+    })
+}
+
+fn uses_mode(ts: &[Template], mode: StepsMode) -> bool {
+    ts.iter().any(|t| match t {
+        Template::Steps { mode: m, .. } => *m == mode,
+        Template::Control { children, .. } => uses_mode(children, mode),
+        Template::Decorator { child, .. } => uses_mode(std::slice::from_ref(child), mode),
+        _ => false,
+    })
+}
+
+/// Walks a rule tree's leaves and reports objects that do not fit the
+/// PDDL type of the port they are bound to.
+fn check_port_types(
+    root: &Node,
+    call: &[Port],
+    input: &LowerInput,
+    types: &Types,
+    report: &mut dyn FnMut(&str, &str, &str, &str),
+) {
+    root.walk(&mut |n| {
+        let Node::Leaf { id, ports, .. } = n else {
+            return;
+        };
+        let Some(decl) = input.decls.nodes.get(id) else {
+            return;
+        };
+        for p in ports {
+            let Some(pd) = decl.ports.iter().find(|d| d.name.text == p.name) else {
+                continue;
+            };
+            let ty = pd.ty.text.to_lowercase();
+            if crate::rules::check::BASIC_TYPES.contains(&ty.as_str())
+                || input.dix.types.id(&ty).is_none()
+            {
+                continue;
+            }
+            let value = match &p.value {
+                PortValue::Param(name) => call
+                    .iter()
+                    .find(|c| c.name == *name)
+                    .map(|c| c.value.to_text()),
+                other => Some(other.to_text()),
+            };
+            if let Some(obj) = value {
+                if input.pix.objects.contains_key(&obj) && !types.object_is(&obj, &ty) {
+                    report(&p.name, id, &obj, &ty);
+                }
+            }
+        }
+    });
+}
+
+fn node_models(decls: &Decls, used: &BTreeSet<String>) -> Vec<NodeModel> {
+    used.iter()
+        .filter_map(|id| {
+            let n = decls.nodes.get(id).cloned().or_else(|| kb_decl(id))?;
+            Some(NodeModel {
+                id: id.clone(),
+                kind: match n.kind {
+                    NodeKind::Action => LeafKind::Action,
+                    NodeKind::Condition => LeafKind::Condition,
+                },
+                ports: n
+                    .ports
+                    .iter()
+                    .map(|p| PortModel {
+                        name: p.name.text.clone(),
+                        direction: if p.out {
+                            PortDirection::Output
+                        } else {
+                            PortDirection::Input
+                        },
+                        ty: p.ty.text.clone(),
+                    })
+                    .collect(),
+                formula: n.formula.as_ref().map(|f| f.to_string()),
+            })
+        })
+        .collect()
+}
+
+/// The `std::kb` declarations btc itself emits, available without import.
+fn kb_decl(id: &str) -> Option<NodeDecl> {
+    let parsed = crate::rules::parse_rules(include_str!("../../stdlib/kb.btrules"), 0);
+    parsed.items.into_iter().find_map(|i| match i.item {
+        Item::Node(n) if n.name.text == id => Some(n),
+        _ => None,
+    })
+}
+
+/// `Fallback(effects already hold, Sequence(preconditions hold, step))`.
+fn backchain(step: Node, info: &StepInfo, t: &ActionTexts, args: &[String]) -> Node {
+    let Some(done) = t.done.as_ref().map(|d| d.ground(args)) else {
+        return step; // no plain effect to test: always run it
+    };
+    let mut seq = Vec::new();
+    if let Some(pre) = &info.pre_start {
+        seq.push(kb_leaf(
+            LeafKind::Condition,
+            "KbHolds",
+            "formula",
+            pre.clone(),
+            Some(format!("step {} ready?", info.index + 1)),
+        ));
+    }
+    seq.push(step);
+    Node::Control {
+        control: ControlKind::Fallback,
+        name: Some(format!("step {} {}", info.index + 1, info.display())),
+        children: vec![
+            kb_leaf(
+                LeafKind::Condition,
+                "KbHolds",
+                "formula",
+                done,
+                Some(format!("step {} done?", info.index + 1)),
+            ),
+            Node::Control {
+                control: ControlKind::Sequence,
+                name: None,
+                children: seq,
+            },
+        ],
+    }
+}
+
+/// Orders steps by causal links and threats: step j comes after step i
+/// (i < j) when i's effects touch j's conditions or effects, or j's effects
+/// touch i's conditions. Steps whose conditions or effects are not plain
+/// conjunctions are ordered after everything before them.
+fn order_steps(input: &LowerInput, texts: &BTreeMap<usize, ActionTexts>, infos: &mut [StepInfo]) {
+    type Lit = (bool, String, Vec<String>);
+    let ground = |lits: &[(bool, String, Vec<Slot>)], args: &[String]| -> Vec<Lit> {
+        lits.iter()
+            .map(|(p, pred, slots)| {
+                let a = slots
+                    .iter()
+                    .map(|s| match s {
+                        Slot::Param(i) => args[*i].clone(),
+                        Slot::Const(c) => c.clone(),
+                    })
+                    .collect();
+                (*p, pred.clone(), a)
+            })
+            .collect()
+    };
+    let per_step: Vec<Option<(Vec<Lit>, Vec<Lit>)>> = infos
+        .iter()
+        .map(|info| {
+            let t = &texts[&input.steps[info.index].action];
+            t.literals
+                .as_ref()
+                .map(|l| (ground(&l.pre, &info.args), ground(&l.eff, &info.args)))
+        })
+        .collect();
+    let touches = |a: &[Lit], b: &[Lit]| {
+        a.iter()
+            .any(|(_, p, x)| b.iter().any(|(_, q, y)| p == q && x == y))
+    };
+    for j in 0..infos.len() {
+        if infos[j].skipped {
+            continue;
+        }
+        let mut after = Vec::new();
+        for i in 0..j {
+            if infos[i].skipped {
+                continue;
+            }
+            let dep = match (&per_step[i], &per_step[j]) {
+                (Some((pi, ei)), Some((pj, ej))) => {
+                    touches(ei, pj) || touches(ei, ej) || touches(ej, pi)
+                }
+                _ => true,
+            };
+            if dep {
+                after.push(i);
+            }
+        }
+        infos[j].after = after;
+    }
+}
+
+/// Independent chains of steps under one Parallel node; a step that waits
+/// for a step of another chain starts with `WaitForStep`.
+fn parallel(step_nodes: &[Option<Node>], infos: &[StepInfo]) -> Node {
+    // Transitive "must precede" closure over the `after` lists.
+    let n = infos.len();
+    let mut precedes: Vec<BTreeSet<usize>> = vec![BTreeSet::new(); n];
+    for j in 0..n {
+        let mut set = BTreeSet::new();
+        for &i in &infos[j].after {
+            set.insert(i);
+            set.extend(precedes[i].iter().copied());
+        }
+        precedes[j] = set;
+    }
+    let mut chains: Vec<Vec<usize>> = Vec::new();
+    for j in (0..n).filter(|&j| step_nodes[j].is_some()) {
+        // Extend a chain whose last step must precede j anyway.
+        match chains
+            .iter_mut()
+            .find(|c| precedes[j].contains(c.last().expect("non-empty")))
+        {
+            Some(c) => c.push(j),
+            None => chains.push(vec![j]),
+        }
+    }
+    let branches: Vec<Node> = chains
+        .iter()
+        .map(|chain| {
+            let mut seq = Vec::new();
+            for (k, &j) in chain.iter().enumerate() {
+                let prev = if k > 0 { Some(chain[k - 1]) } else { None };
+                // Direct predecessors outside this chain (others are implied).
+                for &i in &infos[j].after {
+                    let implied = prev.is_some_and(|p| p == i || precedes[p].contains(&i));
+                    if !implied && !chain[..k].contains(&i) {
+                        seq.push(Node::Leaf {
+                            leaf: LeafKind::Action,
+                            id: "WaitForStep".into(),
+                            name: Some(format!("wait for step {}", i + 1)),
+                            ports: vec![Port {
+                                name: "step".into(),
+                                value: PortValue::Int(i as i64 + 1),
+                            }],
+                        });
+                    }
+                }
+                seq.push(step_nodes[j].clone().expect("filtered"));
+            }
+            Node::Control {
+                control: ControlKind::Sequence,
+                name: None,
+                children: seq,
+            }
+        })
+        .collect();
+    let count = branches.len().max(1) as u32;
+    Node::Control {
+        control: ControlKind::Parallel {
+            success: count,
+            failure: 1,
+        },
+        name: Some("plan".into()),
+        children: branches,
+    }
+}
