@@ -688,3 +688,49 @@ pub fn compile(db: &dyn Db, job: CompileJob) -> Result<crate::ir::TreeIr, Vec<Di
     };
     crate::lower::lower(&input)
 }
+
+#[cfg(test)]
+mod compile_tests {
+    use super::*;
+
+    /// Loads an example folder (rules, domain, problem, the first plan).
+    pub fn example_job(db: &mut Database, dir: &str) -> CompileJob {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+        let mut plan = None;
+        let mut rules = None;
+        for e in std::fs::read_dir(root.join(dir)).unwrap() {
+            let p = e.unwrap().path();
+            let name = p.file_name().unwrap().to_string_lossy().into_owned();
+            if !p.is_file() {
+                continue;
+            }
+            let f = db.set_file(
+                &format!("{dir}/{name}"),
+                std::fs::read_to_string(&p).unwrap(),
+            );
+            if name.starts_with("plan.") && plan.is_none() {
+                plan = Some(f);
+            }
+            if name == "rules.btrules" {
+                rules = Some(f);
+            }
+        }
+        let problem = db.file(&format!("{dir}/problem.pddl"));
+        CompileJob::new(db, rules.unwrap(), plan.unwrap(), problem, None)
+    }
+
+    #[test]
+    fn the_examples_compile() {
+        for dir in ["examples/ariac", "examples/p3_assembler"] {
+            let mut db = Database::new();
+            let job = example_job(&mut db, dir);
+            let ir = compile(&db, job)
+                .as_ref()
+                .unwrap_or_else(|e| panic!("{dir}: {e:#?}"));
+            assert!(!ir.steps.is_empty());
+            if std::env::var_os("BTC_PRINT_IR").is_some() {
+                println!("{}", serde_json::to_string_pretty(ir).unwrap());
+            }
+        }
+    }
+}

@@ -337,7 +337,8 @@ impl Inst<'_> {
     /// Parametric mode: the parameter standing for this value.
     fn param_for(&mut self, v: &Value, preferred: &str) -> PortValue {
         let params = self.params.as_mut().expect("parametric mode");
-        if let Some((name, _)) = params.iter().find(|(_, e)| e == v) {
+        let key = value_key(v);
+        if let Some((name, _)) = params.iter().find(|(_, e)| value_key(e) == key) {
             return PortValue::Param(name.clone());
         }
         let mut name = preferred.to_owned();
@@ -527,6 +528,31 @@ impl Inst<'_> {
             Template::Steps { mode, .. } => steps(*mode),
             Template::Error { .. } => Vec::new(),
         }
+    }
+}
+
+/// A value's identity without its spans: two uses of `?robot` are one
+/// parameter.
+fn value_key(v: &Value) -> String {
+    match v {
+        Value::Var { name } => format!("?{}", name.text),
+        Value::Name { name } => format!("capture {}", name.text),
+        Value::Str { value } => {
+            let parts: Vec<String> = value
+                .parts
+                .iter()
+                .map(|p| match p {
+                    StrPart::Text { text } => format!("{text:?}"),
+                    StrPart::Var { name } => format!("?{}", name.text),
+                    StrPart::Capture { name } => format!("{{{}}}", name.text),
+                })
+                .collect();
+            format!("string {}", parts.join(" "))
+        }
+        Value::Int { value, .. } => format!("int {value}"),
+        Value::Float { value, .. } => format!("float {value}"),
+        Value::Bool { value, .. } => format!("bool {value}"),
+        Value::Lookup { table, key, .. } => format!("{}[{}]", table.text, value_key(key)),
     }
 }
 
