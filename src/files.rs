@@ -5,6 +5,70 @@ use btc_lang::diagnostic::{codes, Diagnostic};
 use btc_lang::source::{decode, DecodeProblem, FileId, Sources, Span};
 use std::path::Path;
 
+/// Reads a file into the database (under its normalized path), reporting
+/// encoding problems as diagnostics. `Err` only when it cannot be read.
+pub fn load_into_db(
+    db: &mut btc_lang::db::Database,
+    path: &Path,
+    diags: &mut Vec<Diagnostic>,
+) -> anyhow::Result<btc_lang::db::SourceFile> {
+    let key = btc_lang::db::normalize(path);
+    let len = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
+    if len > btc_lang::source::MAX_FILE_BYTES as u64 {
+        let f = db.set_file(&key, String::new());
+        diags.push(too_large(btc_lang::db::file_id(db, f), len));
+        return Ok(f);
+    }
+    let bytes = std::fs::read(path).map_err(|e| {
+        anyhow::anyhow!(
+            "[{}] cannot read `{}`: {e}",
+            codes::FILE_UNREADABLE.id,
+            path.display()
+        )
+    })?;
+    let (text, problem) = decode(&bytes);
+    let f = db.set_file(&key, text);
+    if let Some(p) = problem {
+        diags.push(decode_diagnostic(btc_lang::db::file_id(db, f), p));
+    }
+    Ok(f)
+}
+
+fn decode_diagnostic(id: FileId, problem: DecodeProblem) -> Diagnostic {
+    match problem {
+        DecodeProblem::InvalidUtf8 { offset, byte } => Diagnostic::error(
+            codes::FILE_ENCODING,
+            Span::new(id, offset, offset + 3),
+            format!("this file is not UTF-8: byte 0x{byte:02X} at offset {offset} is not valid"),
+        )
+        .with_hint("save the file as UTF-8; btc read the rest with the bad bytes replaced"),
+        DecodeProblem::BadUtf16 => Diagnostic::error(
+            codes::FILE_ENCODING,
+            Span::new(id, 0, 0),
+            "this file starts with a UTF-16 byte-order mark but is not valid UTF-16",
+        )
+        .with_hint("save the file as UTF-8"),
+        DecodeProblem::TooLarge { bytes } => too_large(id, bytes as u64),
+    }
+}
+
+/// Writes `text` to `path` through a temporary file in the same folder and
+/// a rename, so a failed run never leaves a half-written output.
+pub fn write_atomically(path: &Path, text: &str) -> anyhow::Result<()> {
+    use std::io::Write;
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let mut tmp = tempfile::NamedTempFile::new_in(dir)
+        .map_err(|e| anyhow::anyhow!("cannot write in `{}`: {e}", dir.display()))?;
+    tmp.write_all(text.as_bytes())?;
+    tmp.as_file().sync_all()?;
+    tmp.persist(path)
+        .map_err(|e| anyhow::anyhow!("cannot write `{}`: {}", path.display(), e.error))?;
+    Ok(())
+}
+
 /// Reads a file. `Err` only when it cannot be read at all.
 pub fn load(
     sources: &mut Sources,

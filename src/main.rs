@@ -4,6 +4,7 @@
 mod files;
 mod pddl_cmd;
 mod report;
+mod rules_cmd;
 mod validate_cmd;
 
 use clap::{Parser, Subcommand, ValueEnum};
@@ -48,6 +49,43 @@ enum Command {
         #[arg(long, value_enum, default_value_t)]
         format: Format,
     },
+    /// Check a `.btrules` file against its PDDL domain.
+    Check {
+        rules: PathBuf,
+        /// A problem, to check object names in the rules.
+        #[arg(long)]
+        problem: Option<PathBuf>,
+        #[arg(long, value_enum, default_value_t)]
+        format: Format,
+    },
+    /// Compile a plan with a rules file into a behavior tree.
+    Compile {
+        rules: PathBuf,
+        /// The plan to compile.
+        #[arg(long)]
+        plan: PathBuf,
+        /// The PDDL problem the plan solves (default: the rules file's `problem`).
+        #[arg(long)]
+        problem: Option<PathBuf>,
+        /// The PDDL domain (default: the rules file's `domain`).
+        #[arg(long)]
+        domain: Option<PathBuf>,
+        /// The output format.
+        #[arg(long, value_enum)]
+        emit: EmitFormat,
+        /// Write here (atomically) instead of to stdout.
+        #[arg(short = 'o', long = "output")]
+        output: Option<PathBuf>,
+        /// BT.CPP: one flat tree instead of a SubTree per rule.
+        #[arg(long)]
+        inline: bool,
+        /// py_trees: import leaf behaviours from this Python module.
+        #[arg(long)]
+        node_module: Option<String>,
+        /// How to print diagnostics.
+        #[arg(long, value_enum, default_value_t)]
+        format: Format,
+    },
     /// Check that a plan is valid: every step applicable, the goal reached.
     Validate {
         domain: PathBuf,
@@ -56,6 +94,30 @@ enum Command {
         #[arg(long, value_enum, default_value_t)]
         format: Format,
     },
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum EmitFormat {
+    Btcpp,
+    Pytrees,
+    Json,
+    Dot,
+    Mermaid,
+    Commands,
+}
+
+impl From<EmitFormat> for btc_lang::emit::Format {
+    fn from(f: EmitFormat) -> Self {
+        use btc_lang::emit::Format as F;
+        match f {
+            EmitFormat::Btcpp => F::Btcpp,
+            EmitFormat::Pytrees => F::Pytrees,
+            EmitFormat::Json => F::Json,
+            EmitFormat::Dot => F::Dot,
+            EmitFormat::Mermaid => F::Mermaid,
+            EmitFormat::Commands => F::Commands,
+        }
+    }
 }
 
 fn main() -> ExitCode {
@@ -67,6 +129,34 @@ fn main() -> ExitCode {
             json,
             format,
         } => pddl_cmd::run(&files, domain.as_deref(), json, format),
+        Command::Check {
+            rules,
+            problem,
+            format,
+        } => rules_cmd::check(&rules, problem.as_deref(), format),
+        Command::Compile {
+            rules,
+            plan,
+            problem,
+            domain,
+            emit,
+            output,
+            inline,
+            node_module,
+            format,
+        } => rules_cmd::compile(&rules_cmd::CompileArgs {
+            rules,
+            plan,
+            problem,
+            domain,
+            emit: emit.into(),
+            output,
+            options: btc_lang::emit::Options {
+                inline,
+                node_module,
+            },
+            format,
+        }),
         Command::Validate {
             domain,
             problem,

@@ -181,7 +181,7 @@ pub mod codes {
         R_UNUSED = "R014", "a declaration nothing uses";
         R_NO_RULE = "R015", "a plan step that no rule matches";
         R_STEP_TYPE = "R016", "a plan step whose argument types do not fit the rule";
-        R_NO_DOMAIN = "R017", "a rules file without a usable `domain`";
+        R_NO_DOMAIN = "R017", "a PDDL domain or problem that is missing or unusable";
         R_IMPORT = "R018", "an import that cannot be found";
         R_DUPLICATE = "R019", "a name declared twice";
         R_UNKNOWN_OBJECT = "R020", "a string naming an object the domain or problem does not have";

@@ -1,0 +1,178 @@
+//! `btc check` and `btc compile`: rules files, through the incremental
+//! database.
+
+use crate::{files, report, Format};
+use btc_lang::db::{self, CompileJob, Database, SourceFile};
+use btc_lang::diagnostic::{has_errors, Diagnostic};
+use btc_lang::emit;
+use btc_lang::rules::{ImportTarget, Item};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+/// Loads a rules file and everything it names (domain, problem, imports),
+/// transitively, from disk into the database.
+pub fn load_rules(
+    db: &mut Database,
+    path: &Path,
+    diags: &mut Vec<Diagnostic>,
+) -> anyhow::Result<SourceFile> {
+    let root = files::load_into_db(db, path, diags)?;
+    let mut pending = vec![path.to_path_buf()];
+    let mut seen = std::collections::BTreeSet::new();
+    while let Some(p) = pending.pop() {
+        if !seen.insert(db::normalize(&p)) {
+            continue;
+        }
+        let Some(f) = db.file(&db::normalize(&p)) else {
+            continue;
+        };
+        let dir = p.parent().map(Path::to_path_buf).unwrap_or_default();
+        let mut named: Vec<(String, bool)> = Vec::new(); // (path, is rules)
+        for n in &db::parsed_rules(db, f).items {
+            match &n.item {
+                Item::Domain { path, .. } | Item::Problem { path, .. } => {
+                    named.extend(path.plain().map(|s| (s, false)))
+                }
+                Item::Import {
+                    target: ImportTarget::Path { path },
+                    ..
+                } => named.extend(path.plain().map(|s| (s, true))),
+                _ => {}
+            }
+        }
+        for (written, is_rules) in named {
+            let full = dir.join(&written);
+            if db.file(&db::normalize(&full)).is_none() && full.is_file() {
+                // Unreadable files are reported by the checker as not found.
+                let _ = files::load_into_db(db, &full, diags);
+            }
+            if is_rules {
+                pending.push(full);
+            }
+        }
+    }
+    Ok(root)
+}
+
+pub fn check(path: &Path, problem: Option<&Path>, format: Format) -> anyhow::Result<ExitCode> {
+    let mut database = Database::new();
+    let mut diags = Vec::new();
+    let rules = load_rules(&mut database, path, &mut diags)?;
+    if let Some(p) = problem {
+        files::load_into_db(&mut database, p, &mut diags)?;
+    }
+    diags.extend(db::rules_diagnostics(&database, rules).iter().cloned());
+    if let Some(d) = db::domain_file(&database, rules) {
+        diags.extend(db::checked_domain(&database, d).diagnostics.iter().cloned());
+    }
+    let sources = database.sources();
+    let json = report::diagnostics(&diags, &sources, format);
+    let (e, w) = report::count(&diags);
+    match format {
+        Format::Json => println!(
+            "{}",
+            serde_json::to_string_pretty(
+                &serde_json::json!({ "ok": e == 0, "diagnostics": json })
+            )?
+        ),
+        Format::Text => {
+            let items = db::parsed_rules(&database, rules).items.len();
+            println!(
+                "{}: {}; {}, {}",
+                path.display(),
+                report::plural(items, "item"),
+                report::plural(e, "error"),
+                report::plural(w, "warning")
+            );
+        }
+    }
+    Ok(if e > 0 {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
+    })
+}
+
+pub struct CompileArgs {
+    pub rules: PathBuf,
+    pub plan: PathBuf,
+    pub problem: Option<PathBuf>,
+    pub domain: Option<PathBuf>,
+    pub emit: emit::Format,
+    pub output: Option<PathBuf>,
+    pub options: emit::Options,
+    pub format: Format,
+}
+
+pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
+    let mut database = Database::new();
+    let mut diags = Vec::new();
+    let rules = load_rules(&mut database, &a.rules, &mut diags)?;
+    let plan = files::load_into_db(&mut database, &a.plan, &mut diags)?;
+    // The problem: given, named by the rules file, or `problem.pddl` beside
+    // the plan or the rules.
+    let problem_path = a.problem.clone().or_else(|| {
+        if db::declared_path(&database, rules, true).is_some() {
+            return None;
+        }
+        [a.plan.parent(), a.rules.parent()]
+            .into_iter()
+            .flatten()
+            .map(|d| d.join("problem.pddl"))
+            .find(|p| p.is_file())
+    });
+    let problem = problem_path
+        .as_deref()
+        .map(|p| files::load_into_db(&mut database, p, &mut diags))
+        .transpose()?;
+    let domain = a
+        .domain
+        .as_deref()
+        .map(|p| files::load_into_db(&mut database, p, &mut diags))
+        .transpose()?;
+    let job = CompileJob::new(&database, rules, plan, problem, domain);
+    diags.extend(db::job_diagnostics(&database, job).iter().cloned());
+    let result = if has_errors(&diags) {
+        None
+    } else {
+        db::compile(&database, job).as_ref().ok()
+    };
+    if result.is_none() {
+        if let Err(errs) = db::compile(&database, job) {
+            for e in errs {
+                if !diags.contains(e) {
+                    diags.push(e.clone());
+                }
+            }
+        }
+    }
+    let sources = database.sources();
+    let json = report::diagnostics(&diags, &sources, a.format);
+    let Some(ir) = result else {
+        if a.format == Format::Json {
+            println!(
+                "{}",
+                serde_json::to_string_pretty(
+                    &serde_json::json!({ "ok": false, "diagnostics": json })
+                )?
+            );
+        }
+        return Ok(ExitCode::from(1));
+    };
+    let text = emit::emit(ir, a.emit, &a.options);
+    match &a.output {
+        Some(out) => {
+            files::write_atomically(out, &text)?;
+            let steps = ir.steps.iter().filter(|s| !s.skipped).count();
+            eprintln!(
+                "wrote {} ({} of {} plan steps, {} skipped)",
+                out.display(),
+                report::plural(steps, "step"),
+                ir.steps.len(),
+                ir.steps.len() - steps
+            );
+        }
+        None => print!("{text}"),
+    }
+    Ok(ExitCode::SUCCESS)
+}
