@@ -86,6 +86,14 @@ enum Command {
         #[arg(long, value_enum, default_value_t)]
         format: Format,
     },
+    /// Format `.btrules` files in place.
+    Fmt {
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        /// Only report files that are not formatted (exit 1 if any).
+        #[arg(long)]
+        check: bool,
+    },
     /// Check that a plan is valid: every step applicable, the goal reached.
     Validate {
         domain: PathBuf,
@@ -157,6 +165,7 @@ fn main() -> ExitCode {
             },
             format,
         }),
+        Command::Fmt { files, check } => rules_cmd::fmt(&files, check),
         Command::Validate {
             domain,
             problem,

@@ -176,3 +176,46 @@ pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
     }
     Ok(ExitCode::SUCCESS)
 }
+
+/// `btc fmt [--check] FILES`: formats in place (atomically), or with
+/// `--check` lists the files that are not formatted and exits 1.
+pub fn fmt(paths: &[PathBuf], check: bool) -> anyhow::Result<ExitCode> {
+    let mut failed = false;
+    for path in paths {
+        let mut diags = Vec::new();
+        let mut sources = btc_lang::source::Sources::new();
+        let id = files::load(&mut sources, path, &mut diags)?;
+        let text = sources.text(id).to_owned();
+        match btc_lang::rules::fmt::format(&text) {
+            Err(errs) => {
+                // Re-anchor the parse errors on this file for rendering.
+                let errs: Vec<Diagnostic> = errs
+                    .into_iter()
+                    .map(|mut d| {
+                        d.span.file = id;
+                        d.labels.iter_mut().for_each(|l| l.span.file = id);
+                        d
+                    })
+                    .collect();
+                eprint!("{}", btc_lang::render::to_terminal(&errs, &sources, false));
+                eprintln!("{}: not formatted: it does not parse", path.display());
+                failed = true;
+            }
+            Ok(formatted) if formatted == text => {}
+            Ok(formatted) => {
+                if check {
+                    println!("{}: not formatted", path.display());
+                    failed = true;
+                } else {
+                    files::write_atomically(path, &formatted)?;
+                    println!("{}: formatted", path.display());
+                }
+            }
+        }
+    }
+    Ok(if failed {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
+    })
+}
