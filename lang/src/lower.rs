@@ -360,11 +360,12 @@ impl Inst<'_> {
         }
     }
 
-    fn value(&mut self, v: &Value) -> PortValue {
+    /// A port's value; `port` names the parameter a computed value becomes.
+    fn value(&mut self, v: &Value, port: &str) -> PortValue {
         if self.tree_ports.is_empty() && self.params.is_some() && Self::depends_on_step(v) {
             let preferred = match v {
                 Value::Var { name } | Value::Name { name } => name.text.clone(),
-                _ => "value".to_owned(),
+                _ => port.to_owned(),
             };
             return self.param_for(v, &preferred);
         }
@@ -502,7 +503,7 @@ impl Inst<'_> {
                     .iter()
                     .map(|a| Port {
                         name: a.port.text.clone(),
-                        value: self.value(&a.value),
+                        value: self.value(&a.value, &a.port.text),
                     })
                     .collect();
                 if self.decls.trees.contains_key(&name.text) {
