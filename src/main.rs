@@ -52,9 +52,6 @@ enum Command {
     /// Check a `.btrules` file against its PDDL domain.
     Check {
         rules: PathBuf,
-        /// A problem, to check object names in the rules.
-        #[arg(long)]
-        problem: Option<PathBuf>,
         #[arg(long, value_enum, default_value_t)]
         format: Format,
     },
@@ -137,11 +134,7 @@ fn main() -> ExitCode {
             json,
             format,
         } => pddl_cmd::run(&files, domain.as_deref(), json, format),
-        Command::Check {
-            rules,
-            problem,
-            format,
-        } => rules_cmd::check(&rules, problem.as_deref(), format),
+        Command::Check { rules, format } => rules_cmd::check(&rules, format),
         Command::Compile {
             rules,
             plan,

@@ -54,13 +54,12 @@ pub fn load_rules(
     Ok(root)
 }
 
-pub fn check(path: &Path, problem: Option<&Path>, format: Format) -> anyhow::Result<ExitCode> {
+/// `btc check RULES`: the rules file, its imports and its PDDL files. Object
+/// names are checked when the rules file names a `problem`.
+pub fn check(path: &Path, format: Format) -> anyhow::Result<ExitCode> {
     let mut database = Database::new();
     let mut diags = Vec::new();
     let rules = load_rules(&mut database, path, &mut diags)?;
-    if let Some(p) = problem {
-        files::load_into_db(&mut database, p, &mut diags)?;
-    }
     diags.extend(db::rules_diagnostics(&database, rules).iter().cloned());
     if let Some(d) = db::domain_file(&database, rules) {
         diags.extend(db::checked_domain(&database, d).diagnostics.iter().cloned());

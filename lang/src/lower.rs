@@ -664,7 +664,10 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
                         .join(" ")
                 )
             } else {
-                format!("{} rule{} for `{}` exist, but their parameter counts or `where` guards do not fit this step", named.len(), if named.len() == 1 { "" } else { "s" }, action.name.name)
+                match named.len() {
+                    1 => format!("the rule for `{}` does not fit this step: its parameter count or `where` guard rules it out", action.name.name),
+                    n => format!("{n} rules for `{}` exist, but their parameter counts or `where` guards rule this step out", action.name.name),
+                }
             };
             diags.push(
                 Diagnostic::error(

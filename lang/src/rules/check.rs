@@ -922,8 +922,9 @@ fn compare_effect(
     if mine == theirs {
         return None;
     }
-    let missing: Vec<String> = theirs.difference(&mine).map(show_literal).collect();
-    let extra: Vec<String> = mine.difference(&theirs).map(show_literal).collect();
+    let show = |l: &(bool, String, Vec<String>)| show_literal(l, r);
+    let missing: Vec<String> = theirs.difference(&mine).map(show).collect();
+    let extra: Vec<String> = mine.difference(&theirs).map(show).collect();
     let mut parts = Vec::new();
     if !missing.is_empty() {
         parts.push(format!("it leaves out {}", missing.join(", ")));
@@ -949,12 +950,21 @@ fn compare_effect(
     )
 }
 
-fn show_literal((positive, pred, args): &(bool, String, Vec<String>)) -> String {
+/// A literal in the rule's own variables (`#i` is parameter i).
+fn show_literal((positive, pred, args): &(bool, String, Vec<String>), r: &Rule) -> String {
+    let arg = |a: &String| match a.strip_prefix('#').and_then(|i| i.parse::<usize>().ok()) {
+        Some(i) => r.pattern.params.get(i).map_or_else(
+            || format!("parameter {}", i + 1),
+            |p| format!("?{}", p.var.text),
+        ),
+        None => a.clone(),
+    };
     let atom = format!(
         "({pred}{})",
-        args.iter().map(|a| format!(" {a}")).collect::<String>()
+        args.iter()
+            .map(|a| format!(" {}", arg(a)))
+            .collect::<String>()
     );
-    let atom = atom.replace('#', "param ");
     if *positive {
         format!("`{atom}`")
     } else {
@@ -1089,7 +1099,26 @@ pub fn check_file(
     // Coverage and shadowing need the domain.
     if let Some(c) = ctx {
         if !rules.is_empty() {
-            for a in &c.domain.actions {
+            // A misspelled rule is reported (R002) with the action it likely
+            // meant; that action is not reported again as uncovered.
+            let action_names: Vec<&str> =
+                c.domain.actions.iter().map(|a| a.name.as_str()).collect();
+            let meant: BTreeSet<&str> = rules
+                .iter()
+                .filter(|(r, _)| matched_actions(&r.pattern, c.domain).is_empty())
+                .filter_map(|(r, _)| {
+                    closest(
+                        &r.pattern.name_text().to_lowercase(),
+                        action_names.iter().copied(),
+                    )
+                })
+                .collect();
+            for a in c
+                .domain
+                .actions
+                .iter()
+                .filter(|a| !meant.contains(a.name.as_str()))
+            {
                 if !rules
                     .iter()
                     .any(|(r, _)| match_name(&r.pattern.name, &a.name.name).is_some())
@@ -1126,9 +1155,11 @@ pub fn check_file(
             }
         }
     }
-    // Declarations of this file that nothing refers to.
+    // Declarations of this file that nothing refers to (unknowable when an
+    // item did not parse).
     let used = references(items);
-    for i in items {
+    let broken = items.iter().any(|i| has_error_node(&i.item));
+    for i in items.iter().filter(|_| !broken) {
         let (kind, name) = match &i.item {
             Item::Node(n) => ("node", &n.name),
             Item::Tree(t) => ("tree", &t.name),
@@ -1176,6 +1207,28 @@ fn shadows(earlier: &Rule, later: &Rule, domain: &Domain) -> bool {
                 .filter(|&n| bind_params(&later.pattern, n).is_some())
                 .all(|n| bind_params(&earlier.pattern, n).is_some())
     })
+}
+
+/// Whether an item, or a template inside it, did not parse.
+fn has_error_node(item: &Item) -> bool {
+    fn t(x: &Template) -> bool {
+        match x {
+            Template::Error { .. } => true,
+            Template::Control { children, .. } => children.iter().any(t),
+            Template::Decorator { child, .. } => t(child),
+            _ => false,
+        }
+    }
+    match item {
+        Item::Error { .. } => true,
+        Item::Rule(Rule {
+            body: RuleBody::Template { body, .. },
+            ..
+        }) => body.iter().any(t),
+        Item::Tree(tr) => tr.body.iter().any(t),
+        Item::Plan { body, .. } => body.iter().any(t),
+        _ => false,
+    }
 }
 
 /// Names of nodes, trees and tables that templates, guards and lookups use.

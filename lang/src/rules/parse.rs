@@ -244,9 +244,10 @@ fn rich_to_diagnostic(e: &Rich<'_, Tok, SimpleSpan>, file: FileId) -> Diagnostic
         Some(t) => t.to_string(),
         None => "the end of the item".to_owned(),
     };
+    // chumsky quotes tokens ('…'); ours already read `…`.
     let mut expected: Vec<String> = e
         .expected()
-        .map(|p| p.to_string())
+        .map(|p| p.to_string().trim_matches('\'').to_owned())
         .filter(|p| p != "something else")
         .collect();
     expected.sort();
