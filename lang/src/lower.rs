@@ -5,6 +5,7 @@
 //! steps (`steps`, `steps backchained`, `steps parallel`).
 
 use crate::diagnostic::{codes, Diagnostic};
+use crate::ir::format_float;
 use crate::ir::*;
 use crate::pddl::ast::{Action, Domain, Effect, Formula, Problem, Term};
 use crate::pddl::check::{DomainIndex, ProblemIndex};
@@ -317,6 +318,100 @@ struct Inst<'a> {
     tree_ports: Vec<String>,
     used_nodes: BTreeSet<String>,
     used_trees: BTreeSet<String>,
+    /// Nesting of tree expansions (a tree may call trees).
+    depth: usize,
+}
+
+/// A tree declaration's body with the call's argument expressions put in
+/// for its ports (`?port` in values and `{?port}` in strings).
+fn expand_tree(decl: &TreeDecl, args: &[Arg]) -> Vec<Template> {
+    let arg = |port: &str| -> Option<&Value> {
+        args.iter()
+            .find(|a| a.port.text.to_lowercase() == port)
+            .map(|a| &a.value)
+    };
+    fn value<'a>(v: &Value, arg: &dyn Fn(&str) -> Option<&'a Value>) -> Value {
+        match v {
+            Value::Var { name } => arg(&name.text).cloned().unwrap_or_else(|| v.clone()),
+            Value::Str { value: s } => Value::Str {
+                value: string(s, arg),
+            },
+            Value::Lookup { table, key, span } => Value::Lookup {
+                table: table.clone(),
+                key: Box::new(value(key, arg)),
+                span: *span,
+            },
+            other => other.clone(),
+        }
+    }
+    fn string<'a>(s: &StrLit, arg: &dyn Fn(&str) -> Option<&'a Value>) -> StrLit {
+        let mut parts = Vec::new();
+        for p in &s.parts {
+            match p {
+                StrPart::Var { name } => match arg(&name.text) {
+                    Some(Value::Var { name: v }) => parts.push(StrPart::Var { name: v.clone() }),
+                    Some(Value::Name { name: c }) => {
+                        parts.push(StrPart::Capture { name: c.clone() })
+                    }
+                    Some(Value::Str { value }) => parts.extend(value.parts.iter().cloned()),
+                    Some(Value::Int { value, .. }) => parts.push(StrPart::Text {
+                        text: value.to_string(),
+                    }),
+                    Some(Value::Float { value, .. }) => parts.push(StrPart::Text {
+                        text: format_float(*value),
+                    }),
+                    Some(Value::Bool { value, .. }) => parts.push(StrPart::Text {
+                        text: value.to_string(),
+                    }),
+                    Some(Value::Lookup { .. }) | None => parts.push(p.clone()),
+                },
+                other => parts.push(other.clone()),
+            }
+        }
+        StrLit {
+            parts,
+            span: s.span,
+        }
+    }
+    fn template<'a>(t: &Template, arg: &dyn Fn(&str) -> Option<&'a Value>) -> Template {
+        match t {
+            Template::Control {
+                control,
+                name,
+                children,
+                span,
+            } => Template::Control {
+                control: *control,
+                name: name.as_ref().map(|n| string(n, arg)),
+                children: children.iter().map(|c| template(c, arg)).collect(),
+                span: *span,
+            },
+            Template::Decorator {
+                decorator,
+                name,
+                child,
+                span,
+            } => Template::Decorator {
+                decorator: *decorator,
+                name: name.as_ref().map(|n| string(n, arg)),
+                child: Box::new(template(child, arg)),
+                span: *span,
+            },
+            Template::Call { name, args, span } => Template::Call {
+                name: name.clone(),
+                args: args
+                    .iter()
+                    .map(|a| Arg {
+                        port: a.port.clone(),
+                        value: value(&a.value, arg),
+                    })
+                    .collect(),
+                span: *span,
+            },
+            other => other.clone(),
+        }
+    }
+    decl.body.iter().map(|t| template(t, &arg)).collect()
 }
 
 impl Inst<'_> {
@@ -499,6 +594,20 @@ impl Inst<'_> {
                 }]
             }
             Template::Call { name, args, .. } => {
+                if let Some(decl) = self.decls.trees.get(&name.text) {
+                    // Declared trees expand at the call: BT.CPP cannot fill
+                    // `{port}` inside a longer string, so a tree whose body
+                    // interpolates its ports cannot be a shared <SubTree>.
+                    self.used_trees.insert(name.text.clone());
+                    if self.depth >= crate::ir::MAX_CALL_DEPTH {
+                        return Vec::new();
+                    }
+                    let body = expand_tree(decl, args);
+                    self.depth += 1;
+                    let nodes = self.templates(&body, steps);
+                    self.depth -= 1;
+                    return nodes;
+                }
                 let ports: Vec<Port> = args
                     .iter()
                     .map(|a| Port {
@@ -506,25 +615,17 @@ impl Inst<'_> {
                         value: self.value(&a.value, &a.port.text),
                     })
                     .collect();
-                if self.decls.trees.contains_key(&name.text) {
-                    self.used_trees.insert(name.text.clone());
-                    vec![Node::SubTree {
-                        id: tree_id(&name.text),
-                        ports,
-                    }]
-                } else {
-                    self.used_nodes.insert(name.text.clone());
-                    let leaf = match self.decls.nodes.get(&name.text).map(|n| n.kind) {
-                        Some(NodeKind::Condition) => LeafKind::Condition,
-                        _ => LeafKind::Action,
-                    };
-                    vec![Node::Leaf {
-                        leaf,
-                        id: name.text.clone(),
-                        name: None,
-                        ports,
-                    }]
-                }
+                self.used_nodes.insert(name.text.clone());
+                let leaf = match self.decls.nodes.get(&name.text).map(|n| n.kind) {
+                    Some(NodeKind::Condition) => LeafKind::Condition,
+                    _ => LeafKind::Action,
+                };
+                vec![Node::Leaf {
+                    leaf,
+                    id: name.text.clone(),
+                    name: None,
+                    ports,
+                }]
             }
             Template::Steps { mode, .. } => steps(*mode),
             Template::Error { .. } => Vec::new(),
@@ -555,10 +656,6 @@ fn value_key(v: &Value) -> String {
         Value::Bool { value, .. } => format!("bool {value}"),
         Value::Lookup { table, key, .. } => format!("{}[{}]", table.text, value_key(key)),
     }
-}
-
-fn tree_id(name: &str) -> String {
-    format!("tree_{name}")
 }
 
 /// A BT.CPP-safe id for a rule: `rule_PICK_op`.
@@ -700,6 +797,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
                     tree_ports: Vec::new(),
                     used_nodes: BTreeSet::new(),
                     used_trees: BTreeSet::new(),
+                    depth: 0,
                 };
                 let mut nodes = inst.templates(body, &|_| Vec::new());
                 let root = if nodes.len() == 1 {
@@ -729,6 +827,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
             tree_ports: Vec::new(),
             used_nodes: BTreeSet::new(),
             used_trees: BTreeSet::new(),
+            depth: 0,
         };
         let ports: Vec<Port> = rt
             .params
@@ -817,6 +916,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
                 tree_ports: Vec::new(),
                 used_nodes: BTreeSet::new(),
                 used_trees: BTreeSet::new(),
+                depth: 0,
             };
             let mut nodes = inst.templates(t, &arranged);
             used_nodes.extend(inst.used_nodes);
@@ -841,7 +941,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
             }
         });
     }
-    let mut trees: Vec<TreeDef> = rule_trees
+    let trees: Vec<TreeDef> = rule_trees
         .into_iter()
         .map(|(_, rt)| TreeDef {
             id: rt.id,
@@ -849,49 +949,6 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
             root: rt.root,
         })
         .collect();
-    // Declared trees, and the trees they call, transitively.
-    let mut pending: Vec<String> = used_trees.iter().cloned().collect();
-    let mut done_trees = BTreeSet::new();
-    while let Some(name) = pending.pop() {
-        if !done_trees.insert(name.clone()) {
-            continue;
-        }
-        let Some(decl) = input.decls.trees.get(&name) else {
-            continue;
-        };
-        let ports: Vec<String> = decl
-            .ports
-            .iter()
-            .map(|p| p.name.text.to_lowercase())
-            .collect();
-        let mut inst = Inst {
-            decls: input.decls,
-            bindings: &no_bindings,
-            captures: &no_captures,
-            params: Some(Vec::new()),
-            tree_ports: ports.clone(),
-            used_nodes: BTreeSet::new(),
-            used_trees: BTreeSet::new(),
-        };
-        let mut nodes = inst.templates(&decl.body, &|_| Vec::new());
-        let root = if nodes.len() == 1 {
-            nodes.remove(0)
-        } else {
-            Node::sequence(nodes)
-        };
-        root.walk(&mut |n| {
-            if let Node::Leaf { id, .. } = n {
-                used_kb.insert(id.clone());
-            }
-        });
-        used_nodes.extend(inst.used_nodes);
-        pending.extend(inst.used_trees);
-        trees.push(TreeDef {
-            id: tree_id(&name),
-            params: decl.ports.iter().map(|p| p.name.text.clone()).collect(),
-            root,
-        });
-    }
     used_nodes.extend(used_kb);
     let nodes = node_models(input.decls, &used_nodes);
     Ok(TreeIr {
