@@ -1,6 +1,7 @@
 //! Canonical robot commands (the NIST executor): the action leaves in the
 //! order a nominal run executes them, one JSON object per line. Conditions
-//! and btc's KB nodes issue no command; a fallback runs its first child; a
+//! and btc's KB nodes issue no command; a fallback runs its first child
+//! that issues any; a
 //! `repeat(n)` repeats its child's commands n times.
 
 use crate::ir::*;
@@ -24,9 +25,15 @@ fn walk(n: &Node, step: Option<usize>, ir: &TreeIr, out: &mut Vec<Value>) {
         Node::Control {
             control, children, ..
         } => match control {
+            // Nominally a fallback's first child that does anything runs
+            // (in a backchained step, the "done?" check fails first).
             ControlKind::Fallback | ControlKind::ReactiveFallback => {
-                if let Some(first) = children.first() {
-                    walk(first, step, ir, out);
+                for c in children {
+                    let before = out.len();
+                    walk(c, step, ir, out);
+                    if out.len() > before {
+                        break;
+                    }
                 }
             }
             _ => children.iter().for_each(|c| walk(c, step, ir, out)),

@@ -525,6 +525,32 @@ pub fn matched_actions<'d>(
         .collect()
 }
 
+/// The domain actions a rule can match: by name, and by its `capture in
+/// table` guards (the other guards depend on the step's objects).
+pub fn rule_actions<'d>(
+    r: &Rule,
+    decls: &Decls,
+    domain: &'d Domain,
+) -> Vec<(&'d crate::pddl::ast::Action, Vec<(String, String)>)> {
+    matched_actions(&r.pattern, domain)
+        .into_iter()
+        .filter(|(_, caps)| {
+            r.guards.iter().all(|g| match g {
+                Guard::InTable { key, table, .. } => match (
+                    caps.iter().find(|(n, _)| *n == key.text),
+                    decls.tables.get(&table.text),
+                ) {
+                    (Some((_, v)), Some(t)) => {
+                        t.entries.iter().any(|e| e.key.text.eq_ignore_ascii_case(v))
+                    }
+                    _ => true,
+                },
+                _ => true,
+            })
+        })
+        .collect()
+}
+
 fn scope_of(vars: &[(String, Option<Vec<TypeId>>)]) -> Vec<(String, Vec<TypeId>)> {
     vars.iter()
         .map(|(v, t)| {
@@ -787,7 +813,7 @@ fn check_rule(r: &Rule, decls: &Decls, ctx: Option<DomainCtx>) -> Vec<Diagnostic
         diags.extend(tcx.diags);
         return diags;
     };
-    let matched = matched_actions(&r.pattern, c.domain);
+    let matched = rule_actions(r, decls, c.domain);
     if matched.is_empty() {
         let written = r.pattern.name_text();
         let hint = did_you_mean(
