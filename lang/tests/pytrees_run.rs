@@ -3,7 +3,7 @@
 //! `python3` to SUCCESS with the goal reached; a tree full of hostile names
 //! still imports and runs, and its strings come back unchanged.
 //!
-//! Needs `python3` with py_trees 2.x (`pip install py_trees`).
+//! Needs `python3` with py_trees 2.2 or later (`pip install py_trees`).
 
 use btc_lang::db::{compile, CompileJob, Database};
 use btc_lang::emit::pytrees;
@@ -22,12 +22,15 @@ fn repo_root() -> PathBuf {
 /// Fails (never skips) when python3 or py_trees is missing.
 fn require_py_trees() {
     let out = Command::new("python3")
-        .args(["-c", "import py_trees"])
+        .args([
+            "-c",
+            "import py_trees.decorators; py_trees.decorators.Repeat",
+        ])
         .output();
     match out {
         Ok(o) if o.status.success() => {}
         Ok(o) => panic!(
-            "python3 cannot import py_trees; install it with `pip install py_trees`\n{}",
+            "python3 cannot import py_trees 2.2 or later; install it with `pip install py_trees`\n{}",
             String::from_utf8_lossy(&o.stderr)
         ),
         Err(e) => panic!("cannot run python3 ({e}); install Python 3 and `pip install py_trees`"),
@@ -97,8 +100,15 @@ fn example_dirs() -> Vec<PathBuf> {
 /// Compiles `rules` (a file name in `dir`) with the folder's `problem.pddl`
 /// and first `plan.*` file (by name); every file of the folder is loaded.
 fn compile_dir(dir: &Path, rules: &str) -> TreeIr {
-    let prefix = dir.to_string_lossy().into_owned();
-    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+    // Paths as from the repository root, e.g. `examples/ariac/rules.btrules`.
+    let root = repo_root().canonicalize().unwrap();
+    let dir = dir.canonicalize().unwrap();
+    let prefix = dir
+        .strip_prefix(&root)
+        .unwrap_or(&dir)
+        .to_string_lossy()
+        .into_owned();
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
         .unwrap()
         .map(|e| e.unwrap().path())
         .filter(|p| p.is_file())

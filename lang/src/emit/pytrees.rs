@@ -469,7 +469,12 @@ impl Emitter<'_> {
                  # and SUCCESS on the next; a condition evaluates its formula on the KB.\n",
             ),
         }
-        o.push_str("\nimport sys\n\nimport py_trees\n");
+        o.push_str(
+            "#\n# Needs py_trees 2.2 or later (tested with 2.2.3 and 2.6.0).\n\
+             \nimport sys\n\nimport py_trees\n\n\
+             if not hasattr(py_trees.decorators, \"Repeat\"):\n    \
+             sys.exit(\"this module needs py_trees >= 2.2: pip install -U py_trees\")\n",
+        );
         if let Some(m) = node_module {
             let (_, import) = module_import(m);
             o.push_str(&import);
