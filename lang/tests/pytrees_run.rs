@@ -1,0 +1,652 @@
+//! The py_trees emitter end to end: every example under `examples/` (found
+//! by reading the directory) compiles, and the generated module runs under
+//! `python3` to SUCCESS with the goal reached; a tree full of hostile names
+//! still imports and runs, and its strings come back unchanged.
+//!
+//! Needs `python3` with py_trees 2.2 or later (`pip install py_trees`).
+
+use btc_lang::db::{compile, CompileJob, Database};
+use btc_lang::emit::pytrees;
+use btc_lang::ir::{
+    LeafKind, Node, NodeModel, Port, PortDirection, PortModel, PortValue, StepInfo, TreeDef,
+    TreeIr, IR_VERSION,
+};
+use btc_lang::rules::ast::{ControlKind, DecoratorKind};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn repo_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// Fails (never skips) when python3 or py_trees is missing.
+fn require_py_trees() {
+    let out = Command::new("python3")
+        .args([
+            "-c",
+            "import py_trees.decorators; py_trees.decorators.Repeat",
+        ])
+        .output();
+    match out {
+        Ok(o) if o.status.success() => {}
+        Ok(o) => panic!(
+            "python3 cannot import py_trees 2.2 or later; install it with `pip install py_trees`\n{}",
+            String::from_utf8_lossy(&o.stderr)
+        ),
+        Err(e) => panic!("cannot run python3 ({e}); install Python 3 and `pip install py_trees`"),
+    }
+}
+
+/// A fresh directory for one test's files.
+fn work_dir(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join("pytrees_run")
+        .join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn run_python(dir: &Path, args: &[&str]) -> Output {
+    Command::new("python3")
+        .args(args)
+        .current_dir(dir)
+        .env("PYTHONDONTWRITEBYTECODE", "1")
+        .output()
+        .expect("python3 runs")
+}
+
+fn show(out: &Output) -> String {
+    format!(
+        "exit: {:?}\n--- stdout\n{}\n--- stderr\n{}",
+        out.status.code(),
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    )
+}
+
+/// Runs `module.py` in `dir`; asserts exit 0, SUCCESS and the goal reached.
+fn assert_runs_to_success(dir: &Path, what: &str) {
+    let out = run_python(dir, &["module.py"]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{what}: module.py failed\n{}",
+        show(&out)
+    );
+    assert!(
+        stdout.contains("final status: SUCCESS"),
+        "{what}: no SUCCESS\n{}",
+        show(&out)
+    );
+    assert!(
+        stdout.contains("goal reached: True"),
+        "{what}: goal not reached\n{}",
+        show(&out)
+    );
+}
+
+/// Every folder under `examples/` with a `rules.btrules`, sorted.
+fn example_dirs() -> Vec<PathBuf> {
+    let mut dirs: Vec<PathBuf> = std::fs::read_dir(repo_root().join("examples"))
+        .expect("examples/")
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.join("rules.btrules").is_file())
+        .collect();
+    dirs.sort();
+    dirs
+}
+
+/// Compiles `rules` (a file name in `dir`) with the folder's `problem.pddl`
+/// and first `plan.*` file (by name); every file of the folder is loaded.
+fn compile_dir(dir: &Path, rules: &str) -> TreeIr {
+    // Paths as from the repository root, e.g. `examples/ariac/rules.btrules`.
+    let root = repo_root().canonicalize().unwrap();
+    let dir = dir.canonicalize().unwrap();
+    let prefix = dir
+        .strip_prefix(&root)
+        .unwrap_or(&dir)
+        .to_string_lossy()
+        .into_owned();
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.is_file())
+        .collect();
+    files.sort();
+    let mut db = Database::new();
+    let (mut rules_file, mut plan) = (None, None);
+    for p in &files {
+        let file = p.file_name().unwrap().to_string_lossy().into_owned();
+        let f = db.set_file(
+            &format!("{prefix}/{file}"),
+            std::fs::read_to_string(p).unwrap(),
+        );
+        if file == rules {
+            rules_file = Some(f);
+        } else if file.starts_with("plan.") && plan.is_none() {
+            plan = Some(f);
+        }
+    }
+    let problem = db.file(&format!("{prefix}/problem.pddl"));
+    let job = CompileJob::new(
+        &db,
+        rules_file.unwrap_or_else(|| panic!("{prefix}: no {rules}")),
+        plan.unwrap_or_else(|| panic!("{prefix}: no plan.* file")),
+        problem,
+        None,
+    );
+    compile(&db, job)
+        .clone()
+        .unwrap_or_else(|e| panic!("{prefix}/{rules} does not compile: {e:#?}"))
+}
+
+fn compile_example(dir: &Path) -> TreeIr {
+    compile_dir(dir, "rules.btrules")
+}
+
+/// Emits `ir`, checks the text, and runs it to SUCCESS in a fresh directory.
+fn emit_and_run(ir: &TreeIr, name: &str) -> String {
+    let text = pytrees::emit(ir, None);
+    assert_eq!(text, pytrees::emit(ir, None), "{name}: not deterministic");
+    assert!(text.is_ascii(), "{name}: output is not ASCII");
+    let work = work_dir(name);
+    std::fs::write(work.join("module.py"), &text).unwrap();
+    assert_runs_to_success(&work, name);
+    text
+}
+
+#[test]
+fn examples_run_to_success() {
+    require_py_trees();
+    let dirs = example_dirs();
+    assert!(!dirs.is_empty(), "no examples found");
+    for dir in dirs {
+        let name = dir.file_name().unwrap().to_string_lossy().into_owned();
+        emit_and_run(&compile_example(&dir), &name);
+    }
+}
+
+/// Each `*.btrules` not starting with `_` in each folder under
+/// `tests/fixtures/pytrees/` is a job over that folder's problem and plan.
+#[test]
+fn fixtures_run_to_success() {
+    require_py_trees();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/pytrees");
+    let mut dirs: Vec<PathBuf> = std::fs::read_dir(&root)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.is_dir())
+        .collect();
+    dirs.sort();
+    let mut ran = Vec::new();
+    for dir in dirs {
+        let mut jobs: Vec<String> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|n| n.ends_with(".btrules") && !n.starts_with('_'))
+            .collect();
+        jobs.sort();
+        for rules in jobs {
+            let name = format!(
+                "{}_{}",
+                dir.file_name().unwrap().to_string_lossy(),
+                rules.trim_end_matches(".btrules")
+            );
+            let text = emit_and_run(&compile_dir(&dir, &rules), &name);
+            ran.push((name, text));
+        }
+    }
+    // The workshop jobs between them use every construct.
+    let all: String = ran.iter().map(|(_, t)| t.as_str()).collect();
+    for construct in [
+        "ThresholdParallel(",
+        "ParallelPolicy.SuccessOnAll(",
+        "ParallelPolicy.SuccessOnOne(",
+        "py_trees.decorators.Timeout(",
+        "py_trees.decorators.Retry(",
+        "py_trees.decorators.Repeat(",
+        "py_trees.decorators.Inverter(",
+        "py_trees.decorators.FailureIsSuccess(",
+        "py_trees.decorators.SuccessIsFailure(",
+        "py_trees.composites.Selector(name=\"ReactiveFallback\", memory=False",
+        "py_trees.composites.Selector(name=",
+        "KbHolds(",
+        "WaitForStep(",
+    ] {
+        assert!(all.contains(construct), "no job emits {construct}");
+    }
+    assert!(
+        ran.len() >= 3,
+        "fixtures missing: {:?}",
+        ran.iter().map(|r| &r.0).collect::<Vec<_>>()
+    );
+}
+
+/// Leaf classes from a user module: this one makes any class asked for
+/// (PEP 562 module `__getattr__`), each succeeding on its first tick.
+const USER_NODES: &str = r#"
+import py_trees
+
+
+class _Leaf(py_trees.behaviour.Behaviour):
+    def __init__(self, name, /, **ports):
+        super().__init__(name=name)
+        self.ports = ports
+
+    def update(self):
+        return py_trees.common.Status.SUCCESS
+
+
+def __getattr__(name):
+    if name.startswith("__"):
+        raise AttributeError(name)
+    return type(name, (_Leaf,), {})
+"#;
+
+#[test]
+fn examples_run_with_a_node_module() {
+    require_py_trees();
+    for dir in example_dirs() {
+        let name = dir.file_name().unwrap().to_string_lossy().into_owned();
+        let ir = compile_example(&dir);
+        let text = pytrees::emit(&ir, Some("user_nodes"));
+        assert!(text.contains("\nimport user_nodes\n"), "{name}");
+        assert!(
+            !text.contains("(SimulatedAction)"),
+            "{name}: simulated classes emitted"
+        );
+        let work = work_dir(&format!("{name}_node_module"));
+        std::fs::write(work.join("module.py"), &text).unwrap();
+        std::fs::write(work.join("user_nodes.py"), USER_NODES).unwrap();
+        assert_runs_to_success(&work, &format!("{name} with user_nodes"));
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Hostile names
+
+/// Object names: PDDL tokens (no blanks, no parentheses) with everything else.
+const OBJ_A: &str = "o\"1'''";
+const OBJ_B: &str = "</b>\"\"\"\\ü";
+const OBJ_C: &str = "日本#x\\";
+
+fn text(s: &str) -> PortValue {
+    PortValue::Text(s.into())
+}
+
+fn port(name: &str, value: PortValue) -> Port {
+    Port {
+        name: name.into(),
+        value,
+    }
+}
+
+fn leaf(kind: LeafKind, id: &str, name: Option<&str>, ports: Vec<Port>) -> Node {
+    Node::Leaf {
+        leaf: kind,
+        id: id.into(),
+        name: name.map(Into::into),
+        ports,
+    }
+}
+
+fn model(id: &str, kind: LeafKind, ports: &[&str], formula: Option<&str>) -> NodeModel {
+    NodeModel {
+        id: id.into(),
+        kind,
+        ports: ports
+            .iter()
+            .map(|p| PortModel {
+                name: (*p).into(),
+                direction: PortDirection::Input,
+                ty: "string".into(),
+            })
+            .collect(),
+        formula: formula.map(Into::into),
+    }
+}
+
+fn step(index: usize, args: &[&str], eff_end: String) -> StepInfo {
+    StepInfo {
+        index,
+        line: index as u32 + 1,
+        action: "mo\"ve\n".into(),
+        args: args.iter().map(|s| (*s).into()).collect(),
+        time: None,
+        duration: Some(1.0),
+        rule: Some("rule \"\"\"x".into()),
+        skipped: false,
+        pre_start: Some(format!("(at {} {})", args[0], args[1])),
+        pre_over_all: None,
+        pre_end: None,
+        // Step 2 starts by deleting the fact step 1 added.
+        eff_start: (index == 1).then(|| format!("(not (at {} {}))", args[0], args[1])),
+        eff_end: Some(eff_end),
+        after: Vec::new(),
+    }
+}
+
+fn hostile_ir() -> TreeIr {
+    use LeafKind::{Action, Condition};
+    let evil_names = [
+        "Move\"To",
+        "Move'''To",
+        "Move\"\"\"To\\\n</script>",
+        "日本",
+        "class",
+        "print",
+        "__name__",
+        "KnowledgeBase",
+        "n1",
+    ];
+    let mut nodes: Vec<NodeModel> = evil_names
+        .iter()
+        .map(|id| model(id, Action, &["target", "class", "größe", "a\"b"], None))
+        .collect();
+    nodes.push(model(
+        "At?\"Where\n",
+        Condition,
+        &["who", "where"],
+        Some("(at ?who ?where)"),
+    ));
+    // A subtree called with hostile arguments, interpolated into a name.
+    let tree = TreeDef {
+        id: "rule \"'''\n".into(),
+        params: vec!["x".into()],
+        root: Node::Control {
+            control: ControlKind::ReactiveSequence,
+            name: Some("go to {x} \"\"\" '''\n\\ </div>".into()),
+            children: vec![
+                leaf(
+                    Condition,
+                    "At?\"Where\n",
+                    Some("is it \"there\"?\n'''"),
+                    vec![port("who", text(OBJ_A)), port("where", text(OBJ_B))],
+                ),
+                leaf(
+                    Action,
+                    "Move\"To",
+                    None,
+                    vec![
+                        port("target", PortValue::Param("x".into())),
+                        port("class", text("\"\"\"")),
+                        port("größe", PortValue::Float(1.5)),
+                        port("a\"b", PortValue::Bool(true)),
+                    ],
+                ),
+            ],
+        },
+    };
+    let mut children = vec![Node::Step {
+        step: 0,
+        child: Box::new(Node::SubTree {
+            id: tree.id.clone(),
+            ports: vec![port("x", text(OBJ_C))],
+        }),
+    }];
+    let mut others: Vec<Node> = evil_names[1..]
+        .iter()
+        .map(|id| {
+            leaf(
+                Action,
+                id,
+                Some(&format!("node {id} \"\"\"\n'''")),
+                vec![port("target", PortValue::Int(-3))],
+            )
+        })
+        .collect();
+    others.push(leaf(
+        Condition,
+        "KbHolds",
+        Some("kb \"holds\"\n"),
+        vec![port("formula", text(&format!("(at {OBJ_A} {OBJ_B})")))],
+    ));
+    children.push(Node::Step {
+        step: 1,
+        child: Box::new(Node::Decorator {
+            decorator: DecoratorKind::Retry { times: 2 },
+            name: Some("retry \"'''\"".into()),
+            child: Box::new(Node::Control {
+                control: ControlKind::Parallel {
+                    success: 2,
+                    failure: 2,
+                },
+                name: None,
+                children: others,
+            }),
+        }),
+    });
+    children.push(leaf(
+        Action,
+        "WaitForStep",
+        Some("wait \"1\""),
+        vec![port("step", PortValue::Int(1))],
+    ));
+    children.push(leaf(
+        Action,
+        "KbApply",
+        None,
+        vec![port("effect", text(&format!("(done {OBJ_B})")))],
+    ));
+    TreeIr {
+        version: IR_VERSION,
+        domain: "dom\"\"\"ain\n'''\\.pddl".into(),
+        problem: "prob\nimport os; os.system('false')\n#".into(),
+        main_tree: "Main\"Tree".into(),
+        root: Node::Control {
+            control: ControlKind::Sequence,
+            name: Some("root \"\"\" ''' \\ \n </root> ü 日本".into()),
+            children,
+        },
+        trees: vec![tree],
+        nodes,
+        steps: vec![
+            step(0, &[OBJ_A, OBJ_B, OBJ_C], format!("(at {OBJ_A} {OBJ_C})")),
+            step(
+                1,
+                &[OBJ_A, OBJ_C, OBJ_B],
+                format!("(and (at {OBJ_A} {OBJ_B}) (forall (?o - th\"ing) (seen ?o)))"),
+            ),
+        ],
+        objects: vec![
+            (OBJ_A.into(), "th\"ing".into()),
+            (OBJ_B.into(), "th\"ing".into()),
+            (OBJ_C.into(), "pla'''ce".into()),
+        ],
+        init: vec![format!("(at {OBJ_A} {OBJ_B})")],
+        goal: Some(format!(
+            "(and (at {OBJ_A} {OBJ_B}) (done {OBJ_B}) (forall (?o - th\"ing) (seen ?o)) \
+             (not (at {OBJ_A} {OBJ_C})))"
+        )),
+    }
+}
+
+/// Imports the module and prints what it read back, as JSON.
+const DUMP: &str = r#"
+import importlib.util, json, sys
+spec = importlib.util.spec_from_file_location("module", "module.py")
+m = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(m)
+names = []
+def walk(b):
+    names.append(b.name)
+    for c in b.children:
+        walk(c)
+walk(m.create_behavior_tree())
+json.dump({
+    "objects": list(m.OBJECTS.items()),
+    "facts": sorted(list(f) for f in m.INITIAL_FACTS),
+    "classes": m.NODE_CLASS_NAMES,
+    "names": names,
+}, sys.stdout)
+"#;
+
+#[test]
+fn hostile_names_stay_strings() {
+    require_py_trees();
+    let ir = hostile_ir();
+    for module in [None, Some("user_nodes")] {
+        let text = pytrees::emit(&ir, module);
+        assert!(text.is_ascii());
+        for line in text.lines() {
+            // No user text leaks outside a literal: the only `import` lines
+            // are the module's own.
+            if line.trim_start().starts_with("import ") {
+                assert!(
+                    ["import sys", "import py_trees", "import user_nodes"].contains(&line.trim()),
+                    "unexpected import line: {line}"
+                );
+            }
+        }
+        let work = work_dir(if module.is_some() {
+            "hostile_node_module"
+        } else {
+            "hostile"
+        });
+        std::fs::write(work.join("module.py"), &text).unwrap();
+        std::fs::write(work.join("user_nodes.py"), USER_NODES).unwrap();
+        let what = format!("hostile IR, node module {module:?}");
+        assert_runs_to_success(&work, &what);
+
+        let out = run_python(&work, &["-c", DUMP]);
+        assert!(out.status.success(), "{what}: dump failed\n{}", show(&out));
+        let got: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let objects: Vec<(String, String)> =
+            serde_json::from_value(got["objects"].clone()).unwrap();
+        assert_eq!(objects, ir.objects);
+        let facts: Vec<Vec<String>> = serde_json::from_value(got["facts"].clone()).unwrap();
+        assert_eq!(
+            facts,
+            vec![vec!["at".to_string(), OBJ_A.into(), OBJ_B.into()]]
+        );
+        let names: Vec<String> = serde_json::from_value(got["names"].clone()).unwrap();
+        for expected in [
+            "root \"\"\" ''' \\ \n </root> ü 日本",
+            &format!("go to {OBJ_C} \"\"\" '''\n\\ </div>"),
+            "is it \"there\"?\n'''",
+            "Move\"To",
+            "node Move\"\"\"To\\\n</script> \"\"\"\n'''",
+            "node 日本 \"\"\"\n'''",
+            "kb \"holds\"\n",
+            "retry \"'''\"",
+            &format!("step 1: (mo\"ve\n {OBJ_A} {OBJ_B} {OBJ_C})"),
+        ] {
+            assert!(
+                names.iter().any(|n| n == expected),
+                "{what}: name {expected:?} not in {names:#?}"
+            );
+        }
+        let classes: std::collections::BTreeMap<String, String> =
+            serde_json::from_value(got["classes"].clone()).unwrap();
+        let mut unique: Vec<&String> = classes.values().collect();
+        unique.sort();
+        unique.dedup();
+        assert_eq!(unique.len(), classes.len(), "class names not unique");
+        assert_eq!(classes["Move\"To"], "Move_To");
+        assert_eq!(classes["Move'''To"], "Move___To");
+        assert_eq!(classes["print"], "print_2");
+        assert_eq!(classes["__name__"], "Node__name__");
+        assert_eq!(classes["KnowledgeBase"], "KnowledgeBase_2");
+    }
+}
+
+/// Checks of the generated PDDL evaluator, run inside the workshop module.
+const EVALUATOR_CHECKS: &str = r#"
+import importlib.util
+spec = importlib.util.spec_from_file_location("module", "module.py")
+m = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(m)
+kb, p = m.KnowledgeBase(), m.parse_pddl
+
+def holds(text, env=None):
+    return kb.holds(p(text), env)
+
+assert p("(On  A\n(b c))") == ("on", "a", ("b", "c"))
+for bad in ["(a", "a)", "", "(a) (b)"]:
+    try:
+        p(bad)
+    except ValueError:
+        pass
+    else:
+        raise AssertionError("parsed %r" % bad)
+assert holds("(at r1 base)") and holds("(AT R1 Base)")
+assert not holds("(at r1 dock)")
+assert holds("(and (at r1 base) (not (at r1 dock)) (or (at r1 dock) (free r1)))")
+assert holds("(imply (at r1 dock) (checked dock))")
+assert not holds("(imply (at r1 base) (checked dock))")
+assert holds("(= base base)") and not holds("(= base dock)")
+assert holds("(exists (?r - robot) (at ?r base))")
+assert holds("(forall (?r - robot) (at ?r base))")
+assert not holds("(exists (?l - location) (checked ?l))")
+assert holds("(forall (?x ?y - robot) (imply (= ?x ?y) (free ?x)))")
+assert holds("(at ?r ?l)", {"?r": "r1", "?l": "base"})
+# Only the leaf type is known: `agent` (robot's supertype) has no objects.
+assert m.objects_of_type("robot") == ["r1", "r2"]
+assert m.objects_of_type("agent") == []
+assert len(m.objects_of_type("object")) == len(m.OBJECTS)
+assert m.objects_of_type(("either", "robot", "item")) == ["r1", "r2", "i1", "i2"]
+# Delete before add; every part sees the state before the effect.
+kb.apply(p("(and (at r1 base) (not (at r1 base)))"))
+assert holds("(at r1 base)")
+kb.apply(p("(and (not (free r1)) (when (free r1) (checked base)))"))
+assert holds("(and (not (free r1)) (checked base))")
+kb.apply(p("(forall (?i - item) (when (item_at ?i shelf_a) (counted ?i)))"))
+assert holds("(counted i1)") and not holds("(counted i2)")
+kb.apply(p("(and (increase (total-cost) 2) (increase (total-cost) 1))"))
+assert kb.fluents[("total-cost",)] == 3.0
+assert holds("(and (>= (total-cost) 3) (< (total-cost) (+ 1 3)) (= (total-cost) 3))")
+kb.apply(p("(decrease (total-cost) (* 2 (total-cost)))"))
+assert holds("(= (total-cost) -3)")
+kb.reset()
+assert not holds("(counted i1)") and holds("(free r1)") and kb.fluents == {}
+assert not m.goal_reached(kb)
+print("evaluator ok")
+"#;
+
+#[test]
+fn generated_evaluator_follows_pddl() {
+    require_py_trees();
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/pytrees/workshop");
+    let ir = compile_dir(&dir, "in_order.btrules");
+    let work = work_dir("evaluator");
+    std::fs::write(work.join("module.py"), pytrees::emit(&ir, None)).unwrap();
+    let out = run_python(&work, &["-c", EVALUATOR_CHECKS]);
+    assert!(
+        out.status.success() && String::from_utf8_lossy(&out.stdout).contains("evaluator ok"),
+        "{}",
+        show(&out)
+    );
+}
+
+/// A tree whose condition fails ends in FAILURE: exit 1, goal not reached.
+#[test]
+fn failure_exits_nonzero() {
+    require_py_trees();
+    let mut ir = hostile_ir();
+    ir.root = Node::Control {
+        control: ControlKind::Sequence,
+        name: None,
+        children: vec![
+            leaf(
+                LeafKind::Action,
+                "KbApply",
+                None,
+                vec![port("effect", text(&format!("(not (at {OBJ_A} {OBJ_B}))")))],
+            ),
+            leaf(
+                LeafKind::Condition,
+                "At?\"Where\n",
+                None,
+                vec![port("who", text(OBJ_A)), port("where", text(OBJ_B))],
+            ),
+        ],
+    };
+    let work = work_dir("failure");
+    std::fs::write(work.join("module.py"), pytrees::emit(&ir, None)).unwrap();
+    let out = run_python(&work, &["module.py"]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{}", show(&out));
+    assert!(stdout.contains("final status: FAILURE"), "{}", show(&out));
+    assert!(stdout.contains("goal reached: False"), "{}", show(&out));
+}
