@@ -5,7 +5,7 @@
 use std::path::Path;
 use std::process::Command;
 
-const EMITTERS: &[&str] = &["btcpp", "json", "dot", "mermaid", "commands"];
+const EMITTERS: &[&str] = &["btcpp", "pytrees", "json", "dot", "mermaid", "commands"];
 
 /// The first plan of an example folder (`plan.*`, sorted).
 fn plan_of(dir: &Path) -> std::path::PathBuf {

@@ -77,7 +77,11 @@ fn check_5000_lines_after_one_rule_edit(b: Bencher) {
     b.bench_local(|| {
         // Alternate between two versions of one rule in the middle.
         n += 1;
-        let text = if n % 2 == 0 { LARGE.to_owned() } else { LARGE.replacen("retry(3) MoveTo", "retry(4) MoveTo", 1) };
+        let text = if n.is_multiple_of(2) {
+            LARGE.to_owned()
+        } else {
+            LARGE.replacen("retry(3) MoveTo", "retry(4) MoveTo", 1)
+        };
         db.set_file("lang/tests/fixtures/large.btrules", text);
         rules_diagnostics(&db, f).len()
     });

@@ -51,8 +51,11 @@ enum Shape {
     SubTree,
 }
 
-/// Flattens the tree into (id, label, shape) and parent→child edges.
-fn flatten(root: &Node, ir: &TreeIr) -> (Vec<(String, Shape)>, Vec<(usize, usize)>) {
+/// Labelled nodes in depth-first order, and parent→child edges between them.
+type Flat = (Vec<(String, Shape)>, Vec<(usize, usize)>);
+
+/// Flattens the tree into (label, shape) nodes and parent→child edges.
+fn flatten(root: &Node, ir: &TreeIr) -> Flat {
     let mut nodes = Vec::new();
     let mut edges = Vec::new();
     let mut stack: Vec<(&Node, Option<usize>)> = vec![(root, None)];

@@ -310,7 +310,7 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
             value,
             span: sp(e.span()),
         }),
-        strlit.clone().map(|value| Literal::Str { value }),
+        strlit.map(|value| Literal::Str { value }),
         kw("true").map_with(move |_, e| Literal::Bool {
             value: true,
             span: sp(e.span()),
@@ -319,14 +319,14 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
             value: false,
             span: sp(e.span()),
         }),
-        ident.clone().map(|name| Literal::Name { name }),
+        ident.map(|name| Literal::Name { name }),
     ))
     .labelled("a value");
 
     let value = recursive(|value| {
         choice((
-            var.clone().map(|name| Value::Var { name }),
-            strlit.clone().map(|value| Value::Str { value }),
+            var.map(|name| Value::Var { name }),
+            strlit.map(|value| Value::Str { value }),
             int.map_with(move |value, e| Value::Int {
                 value,
                 span: sp(e.span()),
@@ -344,23 +344,22 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
                 span: sp(e.span()),
             }),
             ident
-                .clone()
                 .then(value.delimited_by(punct("["), punct("]")))
                 .map_with(move |(table, key), e| Value::Lookup {
                     table,
                     key: Box::new(key),
                     span: sp(e.span()),
                 }),
-            ident.clone().map(|name| Value::Name { name }),
+            ident.map(|name| Value::Name { name }),
         ))
         .labelled("a value")
     });
 
     let ports = kw("out")
         .or_not()
-        .then(ident.clone())
+        .then(ident)
         .then_ignore(punct(":"))
-        .then(ident.clone())
+        .then(ident)
         .map_with(move |((out, name), ty), e| PortDecl {
             out: out.is_some(),
             name,
@@ -405,15 +404,14 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
                 .ignore_then(parallel_args)
                 .map(|(success, failure)| ControlKind::Parallel { success, failure }),
         ));
-        let control = control_kind
-            .then(strlit.clone().or_not())
-            .then(block)
-            .map_with(move |((control, name), children), e| Template::Control {
+        let control = control_kind.then(strlit.or_not()).then(block).map_with(
+            move |((control, name), children), e| Template::Control {
                 control,
                 name,
                 children,
                 span: sp(e.span()),
-            });
+            },
+        );
         let arg1 = |k: &'static str| kw(k).ignore_then(count.delimited_by(punct("("), punct(")")));
         let decorator_kind = choice((
             arg1("retry").map(|times| DecoratorKind::Retry { times }),
@@ -424,7 +422,7 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
             kw("force_failure").to(DecoratorKind::ForceFailure),
         ));
         let decorator = decorator_kind
-            .then(strlit.clone().or_not())
+            .then(strlit.or_not())
             .then(template.clone())
             .map_with(move |((decorator, name), child), e| Template::Decorator {
                 decorator,
@@ -447,12 +445,10 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
                 span: sp(e.span()),
             });
         let arg = ident
-            .clone()
             .then_ignore(punct(":"))
             .then(value.clone())
             .map(|(port, value)| Arg { port, value });
         let call = ident
-            .clone()
             .then(
                 arg.separated_by(punct(","))
                     .allow_trailing()
@@ -489,23 +485,23 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
         .labelled("a PDDL effect in parentheses");
 
     let domain = kw("domain")
-        .ignore_then(strlit.clone())
+        .ignore_then(strlit)
         .map_with(move |path, e| Item::Domain {
             path,
             span: sp(e.span()),
         });
     let problem = kw("problem")
-        .ignore_then(strlit.clone())
+        .ignore_then(strlit)
         .map_with(move |path, e| Item::Problem {
             path,
             span: sp(e.span()),
         });
     let import = kw("import")
         .ignore_then(choice((
-            strlit.clone().map(|path| ImportTarget::Path { path }),
+            strlit.map(|path| ImportTarget::Path { path }),
             kw("std")
                 .ignore_then(punct("::"))
-                .ignore_then(ident.clone())
+                .ignore_then(ident)
                 .map(|module| ImportTarget::Std { module }),
         )))
         .map_with(move |target, e| Item::Import {
@@ -516,7 +512,7 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
         kw("action").to(NodeKind::Action),
         kw("condition").to(NodeKind::Condition),
     ))
-    .then(ident.clone())
+    .then(ident)
     .then(ports.clone())
     .then(punct("=").ignore_then(formula).or_not())
     .validate(move |(((kind, name), ports), formula), e, emitter| {
@@ -535,7 +531,7 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
         })
     });
     let tree = kw("tree")
-        .ignore_then(ident.clone())
+        .ignore_then(ident)
         .then(ports)
         .then(body_block.clone())
         .map_with(move |((name, ports), body), e| {
@@ -547,10 +543,9 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
             })
         });
     let table = kw("table")
-        .ignore_then(ident.clone())
+        .ignore_then(ident)
         .then(
             ident
-                .clone()
                 .then_ignore(punct(":"))
                 .then(literal)
                 .map(|(key, value)| TableEntry { key, value })
@@ -568,23 +563,21 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
         });
 
     let name_part = choice((
-        ident.clone().map(|i| NamePart::Lit {
+        ident.map(|i| NamePart::Lit {
             text: i.text,
             span: i.span,
         }),
         ident
-            .clone()
             .delimited_by(punct("{"), punct("}"))
             .map(|name| NamePart::Capture { name }),
     ));
     let param = choice((
-        var.clone().map_with(move |var, e| Param {
+        var.map_with(move |var, e| Param {
             var,
             optional: false,
             span: sp(e.span()),
         }),
-        var.clone()
-            .delimited_by(punct("["), punct("]"))
+        var.delimited_by(punct("["), punct("]"))
             .map_with(move |var, e| Param {
                 var,
                 optional: true,
@@ -612,34 +605,30 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
         .map_with(move |(name, params), e| Pattern { name, params, span: sp(e.span()) })
         .labelled("an action pattern such as `(move ?robot ?from ?to)`");
     let guard = choice((
-        var.clone()
-            .then_ignore(punct("!="))
-            .then(var.clone())
+        var.then_ignore(punct("!="))
+            .then(var)
             .map_with(move |(left, right), e| Guard::Ne {
                 left,
                 right,
                 span: sp(e.span()),
             }),
-        var.clone()
-            .then_ignore(punct("=="))
-            .then(var.clone())
+        var.then_ignore(punct("=="))
+            .then(var)
             .map_with(move |(left, right), e| Guard::Eq {
                 left,
                 right,
                 span: sp(e.span()),
             }),
-        var.clone()
-            .then_ignore(punct("-"))
-            .then(ident.clone())
+        var.then_ignore(punct("-"))
+            .then(ident)
             .map_with(move |(var, ty), e| Guard::IsType {
                 var,
                 ty,
                 span: sp(e.span()),
             }),
         ident
-            .clone()
             .then_ignore(kw("in"))
-            .then(ident.clone())
+            .then(ident)
             .map_with(move |(key, table), e| Guard::InTable {
                 key,
                 table,
