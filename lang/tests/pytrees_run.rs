@@ -650,3 +650,61 @@ fn failure_exits_nonzero() {
     assert!(stdout.contains("final status: FAILURE"), "{}", show(&out));
     assert!(stdout.contains("goal reached: False"), "{}", show(&out));
 }
+
+/// Every corpus plan of the domains with rules (`tests/corpus_rules/`),
+/// compiled and run to SUCCESS under py_trees with the goal reached.
+#[test]
+fn corpus_plans_run_to_success() {
+    require_py_trees();
+    let root = repo_root();
+    let mut dirs: Vec<PathBuf> = std::fs::read_dir(root.join("tests/corpus_rules"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    dirs.sort();
+    let mut ran = 0;
+    for dir in dirs {
+        let name = dir.file_name().unwrap().to_string_lossy().into_owned();
+        let rules_path = dir.join("rules.btrules");
+        let rules_text = std::fs::read_to_string(&rules_path).unwrap();
+        let written = rules_text
+            .lines()
+            .find_map(|l| l.strip_prefix("domain \""))
+            .unwrap()
+            .trim_end_matches('"');
+        let corpus = root.join("../shared/corpus/ipc").join(&name);
+        let mut plans: Vec<PathBuf> = std::fs::read_dir(&corpus)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|e| e == "plan" || e == "tplan"))
+            .collect();
+        plans.sort();
+        for plan in plans {
+            let mut db = Database::new();
+            let key = |p: &Path| btc_lang::db::normalize(p);
+            db.set_file(
+                &key(&dir.join(written)),
+                std::fs::read_to_string(dir.join(written)).unwrap(),
+            );
+            let r = db.set_file(&key(&rules_path), rules_text.clone());
+            let stem = plan.file_stem().unwrap().to_string_lossy().into_owned();
+            let problem = corpus.join(format!("{stem}.pddl"));
+            let p = db.set_file(&key(&problem), std::fs::read_to_string(&problem).unwrap());
+            let l = db.set_file(&key(&plan), std::fs::read_to_string(&plan).unwrap());
+            let job = CompileJob::new(&db, r, l, Some(p), None);
+            let ir = compile(&db, job)
+                .clone()
+                .unwrap_or_else(|e| panic!("{}: {e:#?}", plan.display()));
+            let label = format!(
+                "corpus_{name}_{}",
+                plan.file_name()
+                    .unwrap()
+                    .to_string_lossy()
+                    .replace('.', "_")
+            );
+            emit_and_run(&ir, &label);
+            ran += 1;
+        }
+    }
+    assert!(ran >= 12, "only {ran} corpus plans");
+}
