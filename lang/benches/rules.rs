@@ -9,6 +9,10 @@ use btc_lang::emit::{emit, Format, Options};
 use divan::counter::ItemsCount;
 use divan::Bencher;
 
+// The same allocator as the `btc` binary.
+#[global_allocator]
+static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 fn main() {
     divan::main();
 }

@@ -12,7 +12,7 @@ use crate::pddl::check::{DomainIndex, ProblemIndex};
 use crate::plan::{GroundStep, Plan};
 use crate::rules::ast::*;
 use crate::rules::check::Decls;
-use crate::rules::matching::{match_name, match_step, Bindings, Captures, ObjectTypes};
+use crate::rules::matching::{match_args, match_name, Bindings, Captures, ObjectTypes};
 use std::collections::{BTreeMap, BTreeSet};
 
 pub struct LowerInput<'a> {
@@ -304,6 +304,7 @@ struct RuleTree {
     id: String,
     params: Vec<(String, Value)>,
     root: Node,
+    typed: Vec<TypedPort>,
 }
 
 /// Instantiates templates, either with a step's bindings (values filled in)
@@ -708,6 +709,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
     let mut used_nodes = BTreeSet::new();
     let mut used_trees = BTreeSet::new();
     let mut infos = Vec::with_capacity(input.steps.len());
+    let mut name_matches: BTreeMap<(usize, usize), Option<Captures>> = BTreeMap::new();
     let mut step_nodes: Vec<Option<Node>> = Vec::with_capacity(input.steps.len());
     let no_bindings = Bindings::new();
     let no_captures = Captures::new();
@@ -740,8 +742,13 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
             eff_end: ground(&t.eff_end),
             after: Vec::new(),
         };
+        // Names match once per (rule, action); steps repeat actions a lot.
         let found = input.rules.iter().enumerate().find_map(|(ri, r)| {
-            match_step(r, &action.name.name, &args, &tables, &types).map(|m| (ri, *r, m))
+            let caps = name_matches
+                .entry((ri, g.action))
+                .or_insert_with(|| match_name(&r.pattern.name, &action.name.name))
+                .clone()?;
+            match_args(r, caps, &args, &tables, &types).map(|m| (ri, *r, m))
         });
         let Some((ri, rule, (captures, bindings))) = found else {
             let named: Vec<&&Rule> = input
@@ -812,6 +819,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
                     RuleTree {
                         id,
                         params: inst.params.unwrap_or_default(),
+                        typed: typed_ports(&root, input),
                         root,
                     },
                 ));
@@ -839,7 +847,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
             .collect();
         // Objects bound to PDDL-typed ports must fit the port's type.
         check_port_types(
-            &rt.root,
+            &rt.typed,
             &ports,
             input,
             &types,
@@ -989,15 +997,18 @@ fn uses_mode(ts: &[Template], mode: StepsMode) -> bool {
     })
 }
 
-/// Walks a rule tree's leaves and reports objects that do not fit the
-/// PDDL type of the port they are bound to.
-fn check_port_types(
-    root: &Node,
-    call: &[Port],
-    input: &LowerInput,
-    types: &Types,
-    report: &mut dyn FnMut(&str, &str, &str, &str),
-) {
+/// A leaf port of a rule tree whose declared type is a PDDL type, with the
+/// value bound to it (a parameter or a constant).
+struct TypedPort {
+    port: String,
+    node: String,
+    ty: String,
+    value: PortValue,
+}
+
+/// The PDDL-typed ports of a rule tree, found once per rule.
+fn typed_ports(root: &Node, input: &LowerInput) -> Vec<TypedPort> {
+    let mut out = Vec::new();
     root.walk(&mut |n| {
         let Node::Leaf { id, ports, .. } = n else {
             return;
@@ -1015,20 +1026,36 @@ fn check_port_types(
             {
                 continue;
             }
-            let value = match &p.value {
-                PortValue::Param(name) => call
-                    .iter()
-                    .find(|c| c.name == *name)
-                    .map(|c| c.value.to_text()),
-                other => Some(other.to_text()),
-            };
-            if let Some(obj) = value {
-                if input.pix.objects.contains_key(&obj) && !types.object_is(&obj, &ty) {
-                    report(&p.name, id, &obj, &ty);
-                }
-            }
+            out.push(TypedPort {
+                port: p.name.clone(),
+                node: id.clone(),
+                ty,
+                value: p.value.clone(),
+            });
         }
     });
+    out
+}
+
+/// Reports objects bound to PDDL-typed ports that do not fit the port's type.
+fn check_port_types(
+    typed: &[TypedPort],
+    call: &[Port],
+    input: &LowerInput,
+    types: &Types,
+    report: &mut dyn FnMut(&str, &str, &str, &str),
+) {
+    for t in typed {
+        let value = match &t.value {
+            PortValue::Param(name) => call.iter().find(|c| c.name == *name).map(|c| &c.value),
+            other => Some(other),
+        };
+        if let Some(PortValue::Text(obj)) = value {
+            if input.pix.objects.contains_key(obj) && !types.object_is(obj, &t.ty) {
+                report(&t.port, &t.node, obj, &t.ty);
+            }
+        }
+    }
 }
 
 fn node_models(decls: &Decls, used: &BTreeSet<String>) -> Vec<NodeModel> {

@@ -1169,9 +1169,16 @@ pub fn check_file(
                 }
             }
         }
+        // Only a rule without guards or repeated variables can shadow.
+        let shadowers: Vec<usize> = (0..rules.len())
+            .filter(|&i| can_shadow(rules[i].0))
+            .collect();
         for (j, (later, loff)) in rules.iter().enumerate() {
-            if let Some((earlier, eoff)) =
-                rules[..j].iter().find(|(e, _)| shadows(e, later, c.domain))
+            if let Some((earlier, eoff)) = shadowers
+                .iter()
+                .take_while(|&&i| i < j)
+                .map(|&i| &rules[i])
+                .find(|(e, _)| shadows(e, later, c.domain))
             {
                 diags.push(
                     Diagnostic::warning(codes::R_SHADOWED, abs(later.pattern.span, *loff), "this rule never applies: an earlier rule matches every step it matches")
@@ -1210,6 +1217,13 @@ pub fn check_file(
 /// Whether `earlier` matches every step `later` matches: same or wider name
 /// set over the domain's actions, no guards, no repeated variables, and
 /// every argument count `later` accepts.
+/// Whether a rule matches every step its pattern names: no guards and no
+/// repeated variables.
+fn can_shadow(r: &Rule) -> bool {
+    let mut vars = BTreeSet::new();
+    r.guards.is_empty() && r.pattern.params.iter().all(|p| vars.insert(&p.var.text))
+}
+
 fn shadows(earlier: &Rule, later: &Rule, domain: &Domain) -> bool {
     if !earlier.guards.is_empty() {
         return false;

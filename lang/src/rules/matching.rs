@@ -85,8 +85,20 @@ pub fn match_step(
     types: &dyn ObjectTypes,
 ) -> Option<(Captures, Bindings)> {
     let caps = match_name(&rule.pattern.name, action)?;
+    match_args(rule, caps, args, tables, types)
+}
+
+/// The rest of [`match_step`] once the name matched with `caps` (callers
+/// that see the same action name often match names once).
+pub fn match_args(
+    rule: &Rule,
+    caps: Captures,
+    args: &[String],
+    tables: &dyn Fn(&str) -> Option<TableDecl>,
+    types: &dyn ObjectTypes,
+) -> Option<(Captures, Bindings)> {
     let slots = bind_params(&rule.pattern, args.len())?;
-    let mut bindings: Bindings = Vec::new();
+    let mut bindings: Bindings = Vec::with_capacity(args.len());
     for (arg, &slot) in args.iter().zip(&slots) {
         let var = &rule.pattern.params[slot].var.text;
         match bindings.iter().find(|(v, _)| v == var) {
