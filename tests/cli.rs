@@ -1,0 +1,181 @@
+//! The CLI as a user meets it: several errors at once, hostile strings in
+//! outputs, atomic output files, and the design page's examples.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn btc(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_btc"))
+        .args(args)
+        .env("NO_COLOR", "1")
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn check_reports_every_error_with_its_code_and_place() {
+    let out = btc(&[
+        "check",
+        "tests/fixtures/cli/several_errors.btrules",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let found: Vec<(String, u64)> = doc["diagnostics"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|d| d["severity"] == "error")
+        .map(|d| {
+            (
+                d["code"].as_str().unwrap().to_owned(),
+                d["start"]["line"].as_u64().unwrap(),
+            )
+        })
+        .collect();
+    for expected in [
+        ("R006", 7),
+        ("R002", 8),
+        ("R007", 9),
+        ("R004", 10),
+        ("R001", 11),
+    ] {
+        assert!(
+            found.contains(&(expected.0.to_owned(), expected.1)),
+            "missing {expected:?} in {found:?}"
+        );
+    }
+}
+
+#[test]
+fn hostile_names_stay_inside_their_xml_attributes() {
+    let out = btc(&[
+        "compile",
+        "tests/fixtures/cli/hostile.btrules",
+        "--plan",
+        "examples/ariac/plan.txt",
+        "--emit",
+        "btcpp",
+        "--inline",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let xml = String::from_utf8(out.stdout).unwrap();
+    // Parse it back: every attribute value is exactly the original text.
+    let mut reader = quick_xml::Reader::from_str(&xml);
+    let mut names = Vec::new();
+    let mut texts = Vec::new();
+    loop {
+        match reader.read_event().expect("well-formed XML") {
+            quick_xml::events::Event::Eof => break,
+            quick_xml::events::Event::Start(e) | quick_xml::events::Event::Empty(e) => {
+                for a in e.attributes() {
+                    let a = a.unwrap();
+                    let v = a.unescape_value().unwrap().into_owned();
+                    match a.key.as_ref() {
+                        b"name" => names.push(v),
+                        b"text" => texts.push(v),
+                        _ => {}
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    assert!(
+        names
+            .iter()
+            .any(|n| n == "q\" a' </BehaviorTree> <!-- & \n ü 日本 \"\"\" '''"),
+        "{names:?}"
+    );
+    assert!(
+        texts.iter().any(|t| t == "]]> \" ' < > & \t end"),
+        "{texts:?}"
+    );
+    assert!(
+        texts.iter().any(|t| t == "battery_red -> agv1"),
+        "{texts:?}"
+    );
+}
+
+#[test]
+fn output_files_are_written_whole_or_not_at_all() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_path = dir.path().join("tree.xml");
+    std::fs::write(&out_path, "previous contents").unwrap();
+    // A failing compile leaves the old file alone.
+    let bad = btc(&[
+        "compile",
+        "tests/fixtures/cli/several_errors.btrules",
+        "--plan",
+        "examples/ariac/plan.txt",
+        "--emit",
+        "btcpp",
+        "-o",
+        out_path.to_str().unwrap(),
+    ]);
+    assert_eq!(bad.status.code(), Some(1));
+    assert_eq!(
+        std::fs::read_to_string(&out_path).unwrap(),
+        "previous contents"
+    );
+    let good = btc(&[
+        "compile",
+        "examples/ariac/rules.btrules",
+        "--plan",
+        "examples/ariac/plan.txt",
+        "--emit",
+        "btcpp",
+        "-o",
+        out_path.to_str().unwrap(),
+    ]);
+    assert!(good.status.success());
+    assert!(std::fs::read_to_string(&out_path)
+        .unwrap()
+        .starts_with("<?xml"));
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        1,
+        "no temporary file left behind"
+    );
+}
+
+/// The two example files of the design page parse and check as written.
+#[test]
+fn the_design_page_examples_check_as_written() {
+    let page = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/design/btrules-v1.md");
+    let text = std::fs::read_to_string(&page).expect("../shared/design/btrules-v1.md");
+    let blocks: Vec<&str> = text
+        .split("```btrules\n")
+        .skip(1)
+        .map(|b| b.split("```").next().unwrap())
+        .collect();
+    assert_eq!(blocks.len(), 2);
+    for (block, example) in blocks.iter().zip(["ariac", "p3_assembler"]) {
+        let dir = tempfile::tempdir().unwrap();
+        for f in ["domain.pddl", "problem.pddl"] {
+            std::fs::copy(
+                Path::new(env!("CARGO_MANIFEST_DIR"))
+                    .join("examples")
+                    .join(example)
+                    .join(f),
+                dir.path().join(f),
+            )
+            .unwrap();
+        }
+        let rules = dir.path().join("rules.btrules");
+        std::fs::write(&rules, block).unwrap();
+        let out = btc(&["check", rules.to_str().unwrap()]);
+        assert!(
+            out.status.success(),
+            "{example}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(String::from_utf8_lossy(&out.stdout).contains("0 errors"));
+    }
+}
