@@ -179,3 +179,56 @@ fn the_design_page_examples_check_as_written() {
         assert!(String::from_utf8_lossy(&out.stdout).contains("0 errors"));
     }
 }
+
+/// Each example's README shows the picture `--emit mermaid` draws today.
+#[test]
+fn example_readmes_show_the_current_picture() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples");
+    let mut checked = 0;
+    for e in std::fs::read_dir(&root).unwrap() {
+        let dir = e.unwrap().path();
+        if !dir.join("rules.btrules").is_file() {
+            continue;
+        }
+        let readme =
+            std::fs::read_to_string(dir.join("README.md")).expect("every example has a README");
+        let shown = readme
+            .split("```mermaid\n")
+            .nth(1)
+            .and_then(|r| r.split("```").next())
+            .expect("a mermaid picture");
+        let mut plans: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| {
+                p.file_name()
+                    .unwrap()
+                    .to_string_lossy()
+                    .starts_with("plan.")
+            })
+            .collect();
+        plans.sort();
+        let rel = |p: &Path| {
+            p.strip_prefix(env!("CARGO_MANIFEST_DIR"))
+                .unwrap()
+                .to_string_lossy()
+                .into_owned()
+        };
+        let out = btc(&[
+            "compile",
+            &rel(&dir.join("rules.btrules")),
+            "--plan",
+            &rel(&plans[0]),
+            "--emit",
+            "mermaid",
+        ]);
+        assert_eq!(
+            shown,
+            String::from_utf8_lossy(&out.stdout),
+            "{}: regenerate the README picture",
+            dir.display()
+        );
+        checked += 1;
+    }
+    assert!(checked >= 4);
+}

@@ -1,10 +1,10 @@
-//! The reference table in `docs/diagnostics.md` lists exactly the codes the
+//! The reference table in `docs/language.md` lists exactly the codes the
 //! library defines, with the same titles.
 
 #[test]
 fn diagnostic_reference_matches_the_code_list() {
-    let doc = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/diagnostics.md"))
-        .unwrap();
+    let doc =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/language.md")).unwrap();
     let rows: Vec<(String, String)> = doc
         .lines()
         .filter_map(|l| {
