@@ -900,18 +900,22 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
         order_steps(input, &texts, &mut infos);
     }
     let mut used_kb = BTreeSet::new();
+    // The plan template holds `steps` once (R022): the step nodes move into
+    // it instead of being copied.
+    let step_nodes = std::cell::RefCell::new(step_nodes);
     let arranged = |mode: StepsMode| -> Vec<Node> {
+        let nodes = std::mem::take(&mut *step_nodes.borrow_mut());
         match mode {
-            StepsMode::InOrder => step_nodes.iter().flatten().cloned().collect(),
-            StepsMode::Backchained => step_nodes
-                .iter()
+            StepsMode::InOrder => nodes.into_iter().flatten().collect(),
+            StepsMode::Backchained => nodes
+                .into_iter()
                 .zip(&infos)
-                .filter_map(|(n, info)| n.clone().map(|n| (n, info)))
+                .filter_map(|(n, info)| n.map(|n| (n, info)))
                 .map(|(n, info)| {
                     backchain(n, info, &texts[&input.steps[info.index].action], &info.args)
                 })
                 .collect(),
-            StepsMode::Parallel => vec![parallel(&step_nodes, &infos)],
+            StepsMode::Parallel => vec![parallel(&nodes, &infos)],
         }
     };
     let root = match template {

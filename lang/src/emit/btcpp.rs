@@ -15,8 +15,17 @@ use quick_xml::Writer;
 /// Escapes text for an XML attribute value. Newlines and tabs become
 /// character references (a parser would fold them into spaces otherwise);
 /// characters XML 1.0 forbids become U+FFFD.
-pub fn escape_attr(s: &str) -> String {
-    let mut out = String::with_capacity(s.len());
+pub fn escape_attr(s: &str) -> std::borrow::Cow<'_, str> {
+    let plain = |c: char| {
+        !matches!(
+            c,
+            '&' | '<' | '>' | '"' | '\'' | '\u{0}'..='\u{1F}' | '\u{FFFE}' | '\u{FFFF}'
+        )
+    };
+    if s.chars().all(plain) {
+        return std::borrow::Cow::Borrowed(s);
+    }
+    let mut out = String::with_capacity(s.len() + 8);
     for c in s.chars() {
         match c {
             '&' => out.push_str("&amp;"),
@@ -31,7 +40,7 @@ pub fn escape_attr(s: &str) -> String {
             c => out.push(c),
         }
     }
-    out
+    std::borrow::Cow::Owned(out)
 }
 
 /// An XML element name from an id: ids are BT.CPP node names, which user
