@@ -3,7 +3,6 @@
 
 use crate::diagnostic::{codes, Diagnostic};
 use crate::source::{FileId, Span};
-use chumsky::prelude::*;
 use std::fmt;
 
 #[derive(Clone, Debug, PartialEq)]
@@ -51,137 +50,156 @@ pub struct Comment {
     pub trailing: bool,
 }
 
-#[derive(Clone, Debug, PartialEq)]
-enum Lexeme {
-    Tok(Tok),
-    Comment(String),
-    /// A string with no closing quote.
-    Unterminated,
-}
-
-const PUNCTS: &[&str] = &[
-    "=>", "==", "!=", "::", "(", ")", "{", "}", "[", "]", ",", ":", "=", "-",
-];
-
-fn lexer<'s>() -> impl Parser<'s, &'s str, Vec<(Lexeme, SimpleSpan)>, extra::Err<Rich<'s, char>>> {
-    let ident_start = any().filter(|c: &char| c.is_ascii_alphabetic() || *c == '_');
-    let ident_rest = any().filter(|c: &char| c.is_ascii_alphanumeric() || *c == '_' || *c == '-');
-    let ident = ident_start.then(ident_rest.repeated()).to_slice();
-    let var = just('?')
-        .ignore_then(ident)
-        .map(|s: &str| Tok::Var(s.to_owned()));
-    let digits = any()
-        .filter(|c: &char| c.is_ascii_digit())
-        .repeated()
-        .at_least(1);
-    let number = just('-')
-        .or_not()
-        .then(digits)
-        .then(just('.').then(digits).or_not())
-        .to_slice()
-        .map(|s: &str| match s.parse::<i64>() {
-            Ok(n) => Tok::Int(n),
-            Err(_) => s.parse::<f64>().map(Tok::Float).unwrap_or(Tok::Error('0')),
-        });
-    let escape = just('\\').then(any()).ignored();
-    let string_body = escape.or(none_of("\"\\\n").ignored()).repeated().to_slice();
-    let string = just('"')
-        .ignore_then(string_body)
-        .then(just('"').or_not())
-        .map(|(s, close): (&str, _)| match close {
-            Some(_) => Lexeme::Tok(Tok::Str(s.to_owned())),
-            None => Lexeme::Unterminated,
-        });
-    let punct = choice(
-        PUNCTS
-            .iter()
-            .map(|p| just(*p).to(Tok::Punct(p)))
-            .collect::<Vec<_>>(),
-    );
-    let line_comment = just("//")
-        .then(any().filter(|c: &char| *c != '\n').repeated())
-        .to_slice()
-        .map(|s: &str| Lexeme::Comment(s.trim_end().to_owned()));
-    let block_comment = just("/*")
-        .then(any().and_is(just("*/").not()).repeated())
-        .then(just("*/").or_not())
-        .to_slice()
-        .map(|s: &str| Lexeme::Comment(s.to_owned()));
-    let token = choice((
-        line_comment,
-        block_comment,
-        string,
-        number.map(Lexeme::Tok),
-        var.map(Lexeme::Tok),
-        ident.map(|s: &str| Lexeme::Tok(Tok::Ident(s.to_owned()))),
-        punct.map(Lexeme::Tok),
-        any().map(|c| Lexeme::Tok(Tok::Error(c))),
-    ));
-    token
-        .map_with(|t, e| (t, e.span()))
-        .padded()
-        .repeated()
-        .collect()
-}
-
 pub struct Lexed {
     pub tokens: Vec<(Tok, Span)>,
     pub comments: Vec<Comment>,
     pub diagnostics: Vec<Diagnostic>,
 }
 
+const TWO_CHAR_PUNCTS: &[&str] = &["=>", "==", "!=", "::"];
+const ONE_CHAR_PUNCTS: &[&str] = &["(", ")", "{", "}", "[", "]", ",", ":", "=", "-"];
+
+fn is_ident_start(b: u8) -> bool {
+    b.is_ascii_alphabetic() || b == b'_'
+}
+
+fn is_ident_rest(b: u8) -> bool {
+    b.is_ascii_alphanumeric() || b == b'_' || b == b'-'
+}
+
+/// Splits a rules file into tokens and comments. Hand-written (one pass
+/// over the bytes) because the language server re-lexes on every keystroke;
+/// the parser on top is chumsky. Never fails: bad characters become
+/// [`Tok::Error`] tokens with a diagnostic.
 pub fn lex(text: &str, file: FileId) -> Lexed {
-    let (lexemes, errors) = lexer().parse(text).into_output_errors();
+    let b = text.as_bytes();
     let mut out = Lexed {
         tokens: Vec::new(),
         comments: Vec::new(),
-        diagnostics: errors
-            .into_iter()
-            .map(|e| {
-                let s = e.span();
-                Diagnostic::error(
-                    codes::R_SYNTAX,
-                    Span::new(file, s.start, s.end),
-                    format!("cannot read this text: {}", e.reason()),
-                )
-            })
-            .collect(),
+        diagnostics: Vec::new(),
     };
-    let mut last_code_line_end = None::<usize>;
-    for (lexeme, s) in lexemes.unwrap_or_default() {
-        let span = Span::new(file, s.start, s.end);
-        match lexeme {
-            Lexeme::Comment(text_) => {
-                let line_start = text[..s.start].rfind('\n').map_or(0, |i| i + 1);
-                let trailing = last_code_line_end.is_some_and(|e| e >= line_start);
-                out.comments.push(Comment {
-                    text: text_,
-                    span,
-                    trailing,
-                });
-            }
-            Lexeme::Unterminated => {
-                out.diagnostics.push(
-                    Diagnostic::error(codes::R_SYNTAX, span, "this string has no closing `\"`")
-                        .with_hint("strings end on the line they start on"),
-                );
-                out.tokens
-                    .push((Tok::Str(text[s.start + 1..s.end].to_owned()), span));
-                last_code_line_end = Some(s.end);
-            }
-            Lexeme::Tok(Tok::Error(c)) => {
-                out.diagnostics.push(Diagnostic::error(
-                    codes::R_SYNTAX,
-                    span,
-                    format!("`{c}` cannot start anything here"),
-                ));
-                out.tokens.push((Tok::Error(c), span));
-            }
-            Lexeme::Tok(t) => {
-                out.tokens.push((t, span));
-                last_code_line_end = Some(s.end);
-            }
+    let mut i = 0;
+    // End of the last code token, to tell trailing comments from own-line ones.
+    let mut last_code_end: Option<usize> = None;
+    let span = |s: usize, e: usize| Span::new(file, s, e);
+    while i < b.len() {
+        let c = b[i];
+        if c.is_ascii_whitespace() {
+            i += 1;
+            continue;
         }
+        let start = i;
+        // Comments
+        if b[i..].starts_with(b"//") || b[i..].starts_with(b"/*") {
+            let end = if b[i + 1] == b'/' {
+                text[i..].find('\n').map_or(b.len(), |k| i + k)
+            } else {
+                text[i + 2..].find("*/").map_or(b.len(), |k| i + 2 + k + 2)
+            };
+            let line_start = text[..start].rfind('\n').map_or(0, |k| k + 1);
+            let trailing = last_code_end.is_some_and(|e| e >= line_start);
+            let body = &text[start..end];
+            let body = if body.starts_with("//") {
+                body.trim_end()
+            } else {
+                body
+            };
+            out.comments.push(Comment {
+                text: body.to_owned(),
+                span: span(start, end),
+                trailing,
+            });
+            i = end;
+            continue;
+        }
+        let tok = if c == b'"' {
+            // A string ends at an unescaped quote, or (unterminated) at the line's end.
+            let mut j = i + 1;
+            let mut closed = false;
+            while j < b.len() && b[j] != b'\n' {
+                match b[j] {
+                    b'\\' if j + 1 < b.len() && b[j + 1] != b'\n' => j += 2,
+                    b'"' => {
+                        closed = true;
+                        break;
+                    }
+                    _ => j += 1,
+                }
+            }
+            let j = j.min(b.len());
+            if closed {
+                i = j + 1;
+                Tok::Str(text[start + 1..j].to_owned())
+            } else {
+                i = j;
+                out.diagnostics.push(
+                    Diagnostic::error(
+                        codes::R_SYNTAX,
+                        span(start, j),
+                        "this string has no closing `\"`",
+                    )
+                    .with_hint("strings end on the line they start on"),
+                );
+                Tok::Str(text[start + 1..j].to_owned())
+            }
+        } else if c == b'?' && b.get(i + 1).copied().is_some_and(is_ident_start) {
+            let mut j = i + 2;
+            while j < b.len() && is_ident_rest(b[j]) {
+                j += 1;
+            }
+            i = j;
+            Tok::Var(text[start + 1..j].to_owned())
+        } else if c.is_ascii_digit() || (c == b'-' && b.get(i + 1).is_some_and(u8::is_ascii_digit))
+        {
+            let mut j = i + 1;
+            while j < b.len() && b[j].is_ascii_digit() {
+                j += 1;
+            }
+            if j + 1 < b.len() && b[j] == b'.' && b[j + 1].is_ascii_digit() {
+                j += 1;
+                while j < b.len() && b[j].is_ascii_digit() {
+                    j += 1;
+                }
+            }
+            i = j;
+            let word = &text[start..j];
+            match word.parse::<i64>() {
+                Ok(n) => Tok::Int(n),
+                Err(_) => match word.parse::<f64>() {
+                    Ok(f) => Tok::Float(f),
+                    Err(_) => Tok::Error('0'),
+                },
+            }
+        } else if is_ident_start(c) {
+            let mut j = i + 1;
+            while j < b.len() && is_ident_rest(b[j]) {
+                j += 1;
+            }
+            i = j;
+            Tok::Ident(text[start..j].to_owned())
+        } else if let Some(p) = TWO_CHAR_PUNCTS
+            .iter()
+            .find(|p| b[i..].starts_with(p.as_bytes()))
+        {
+            i += 2;
+            Tok::Punct(p)
+        } else if let Some(p) = ONE_CHAR_PUNCTS.iter().find(|p| p.as_bytes()[0] == c) {
+            i += 1;
+            Tok::Punct(p)
+        } else {
+            let ch = text[i..].chars().next().expect("not at the end");
+            i += ch.len_utf8();
+            out.diagnostics.push(Diagnostic::error(
+                codes::R_SYNTAX,
+                span(start, i),
+                format!("`{ch}` cannot start anything here"),
+            ));
+            Tok::Error(ch)
+        };
+        if !matches!(tok, Tok::Error(_)) {
+            last_code_end = Some(i);
+        }
+        out.tokens.push((tok, span(start, i)));
     }
     out
 }
