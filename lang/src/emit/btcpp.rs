@@ -215,8 +215,11 @@ fn port_type(ty: &str) -> &str {
 
 /// The XML document for a compiled plan.
 pub fn emit(ir: &TreeIr, inline: bool) -> String {
+    // Sized up front: growing a buffer of tens of megabytes by doubling
+    // costs more (copies, fresh pages) than writing it.
+    let estimate = 4096 + ir.steps.len() * 320 + ir.trees.len() * 2048;
     let mut x = Xml {
-        w: Writer::new_with_indent(Vec::new(), b' ', 2),
+        w: Writer::new_with_indent(Vec::with_capacity(estimate), b' ', 2),
     };
     x.w.write_event(Event::Decl(BytesDecl::new("1.0", Some("UTF-8"), None)))
         .expect("vec");
