@@ -17,6 +17,8 @@ use std::sync::OnceLock;
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
+mod common;
+
 fn main() {
     divan::main();
 }
@@ -25,26 +27,9 @@ const DOMAIN: &str = include_str!("../../examples/ariac/domain.pddl");
 const PROBLEM: &str = include_str!("../../examples/ariac/problem.pddl");
 const STEPS: usize = 100_000;
 
-/// A valid ARIAC plan of exactly `STEPS` steps: the robot carries the red
-/// battery between bin1 and agv1, ending with it on agv1.
 fn long_plan() -> &'static str {
     static PLAN: OnceLock<String> = OnceLock::new();
-    PLAN.get_or_init(|| {
-        let mut s = String::from("(move floor_robot curr_position bin1)\n");
-        let cycle = [
-            "(grasp floor_robot battery_red bin1)",
-            "(move floor_robot bin1 agv1)",
-            "(place floor_robot battery_red agv1)",
-            "(grasp floor_robot battery_red agv1)",
-            "(move floor_robot agv1 bin1)",
-            "(place floor_robot battery_red bin1)",
-        ];
-        for i in 0..STEPS - 1 {
-            s.push_str(cycle[i % 6]);
-            s.push('\n');
-        }
-        s
-    })
+    PLAN.get_or_init(|| common::long_ariac_plan(STEPS))
 }
 
 #[divan::bench(sample_count = 20)]

@@ -13,6 +13,8 @@ use divan::Bencher;
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
+mod common;
+
 fn main() {
     divan::main();
 }
@@ -24,20 +26,7 @@ const LARGE: &str = include_str!("../tests/fixtures/large.btrules");
 const STEPS: usize = 100_000;
 
 fn long_plan() -> String {
-    let mut s = String::from("(move floor_robot curr_position bin1)\n");
-    let cycle = [
-        "(grasp floor_robot battery_red bin1)",
-        "(move floor_robot bin1 agv1)",
-        "(place floor_robot battery_red agv1)",
-        "(grasp floor_robot battery_red agv1)",
-        "(move floor_robot agv1 bin1)",
-        "(place floor_robot battery_red bin1)",
-    ];
-    for i in 0..STEPS - 1 {
-        s.push_str(cycle[i % 6]);
-        s.push('\n');
-    }
-    s
+    common::long_ariac_plan(STEPS)
 }
 
 #[divan::bench(sample_count = 10)]

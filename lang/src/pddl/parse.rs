@@ -30,31 +30,41 @@ pub fn parse_document(text: &str, file: FileId) -> (Option<Document>, Vec<Diagno
 
 /// Parses text that must be a domain.
 pub fn parse_domain(text: &str, file: FileId) -> (Option<Domain>, Vec<Diagnostic>) {
-    let (doc, mut diags) = parse_document(text, file);
-    match doc {
-        Some(Document::Domain(d)) => (Some(d), diags),
-        Some(Document::Problem(p)) => {
-            diags.push(Diagnostic::error(
-                codes::NOT_A_DEFINE,
-                p.name.span,
-                "expected a domain, but this file defines a problem",
-            ));
-            (None, diags)
-        }
-        None => (None, diags),
-    }
+    parse_kind(text, file, "domain", |doc| match doc {
+        Document::Domain(d) => Ok(d),
+        Document::Problem(p) => Err(p.name.span),
+    })
 }
 
 /// Parses text that must be a problem.
 pub fn parse_problem(text: &str, file: FileId) -> (Option<Problem>, Vec<Diagnostic>) {
+    parse_kind(text, file, "problem", |doc| match doc {
+        Document::Problem(p) => Ok(p),
+        Document::Domain(d) => Err(d.name.span),
+    })
+}
+
+/// Parses a document that must be of one kind; `pick` returns it, or the
+/// span of the other kind's name.
+fn parse_kind<T>(
+    text: &str,
+    file: FileId,
+    want: &str,
+    pick: impl FnOnce(Document) -> Result<T, Span>,
+) -> (Option<T>, Vec<Diagnostic>) {
     let (doc, mut diags) = parse_document(text, file);
-    match doc {
-        Some(Document::Problem(p)) => (Some(p), diags),
-        Some(Document::Domain(d)) => {
+    match doc.map(pick) {
+        Some(Ok(t)) => (Some(t), diags),
+        Some(Err(span)) => {
+            let other = if want == "domain" {
+                "problem"
+            } else {
+                "domain"
+            };
             diags.push(Diagnostic::error(
                 codes::NOT_A_DEFINE,
-                d.name.span,
-                "expected a problem, but this file defines a domain",
+                span,
+                format!("expected a {want}, but this file defines a {other}"),
             ));
             (None, diags)
         }
