@@ -726,29 +726,36 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
             .entry(g.action)
             .or_insert_with(|| ActionTexts::new(action));
         let ground = |s: &Option<Spliced>| s.as_ref().map(|s| s.ground(&args));
+        let (pre_start, pre_over_all, pre_end) = (
+            ground(&t.pre_start),
+            ground(&t.pre_over_all),
+            ground(&t.pre_end),
+        );
+        let (eff_start, eff_end) = (ground(&t.eff_start), ground(&t.eff_end));
         let mut info = StepInfo {
             index: k,
             line: step.line,
             action: action.name.name.clone(),
-            args: args.clone(),
+            args,
             time: step.time,
             duration: step.duration,
             rule: None,
             skipped: false,
-            pre_start: ground(&t.pre_start),
-            pre_over_all: ground(&t.pre_over_all),
-            pre_end: ground(&t.pre_end),
-            eff_start: ground(&t.eff_start),
-            eff_end: ground(&t.eff_end),
+            pre_start,
+            pre_over_all,
+            pre_end,
+            eff_start,
+            eff_end,
             after: Vec::new(),
         };
+        let args = &info.args;
         // Names match once per (rule, action); steps repeat actions a lot.
         let found = input.rules.iter().enumerate().find_map(|(ri, r)| {
             let caps = name_matches
                 .entry((ri, g.action))
                 .or_insert_with(|| match_name(&r.pattern.name, &action.name.name))
                 .clone()?;
-            match_args(r, caps, &args, &tables, &types).map(|m| (ri, *r, m))
+            match_args(r, caps, args, &tables, &types).map(|m| (ri, *r, m))
         });
         let Some((ri, rule, (captures, bindings))) = found else {
             let named: Vec<&&Rule> = input
