@@ -5,19 +5,23 @@ use btc_lang::diagnostic::{codes, Diagnostic};
 use btc_lang::source::{decode, DecodeProblem, FileId, Sources, Span};
 use std::path::Path;
 
-/// Reads a file into the database (under its normalized path), reporting
-/// encoding problems as diagnostics. `Err` only when it cannot be read.
-pub fn load_into_db(
-    db: &mut btc_lang::db::Database,
-    path: &Path,
-    diags: &mut Vec<Diagnostic>,
-) -> anyhow::Result<btc_lang::db::SourceFile> {
-    let key = btc_lang::db::normalize(path);
+/// A file's text as read from disk, and what was wrong with it.
+struct Read {
+    text: String,
+    /// A file over the size limit reads as empty, with this problem.
+    problem: Option<DecodeProblem>,
+}
+
+/// Reads and decodes a file. `Err` only when it cannot be read at all.
+fn read(path: &Path) -> anyhow::Result<Read> {
     let len = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
     if len > btc_lang::source::MAX_FILE_BYTES as u64 {
-        let f = db.set_file(&key, String::new());
-        diags.push(too_large(btc_lang::db::file_id(db, f), len));
-        return Ok(f);
+        return Ok(Read {
+            text: String::new(),
+            problem: Some(DecodeProblem::TooLarge {
+                bytes: len as usize,
+            }),
+        });
     }
     let bytes = std::fs::read(path).map_err(|e| {
         anyhow::anyhow!(
@@ -27,8 +31,19 @@ pub fn load_into_db(
         )
     })?;
     let (text, problem) = decode(&bytes);
-    let f = db.set_file(&key, text);
-    if let Some(p) = problem {
+    Ok(Read { text, problem })
+}
+
+/// Reads a file into the database (under its normalized path), reporting
+/// encoding problems as diagnostics. `Err` only when it cannot be read.
+pub fn load_into_db(
+    db: &mut btc_lang::db::Database,
+    path: &Path,
+    diags: &mut Vec<Diagnostic>,
+) -> anyhow::Result<btc_lang::db::SourceFile> {
+    let r = read(path)?;
+    let f = db.set_file(&btc_lang::db::normalize(path), r.text);
+    if let Some(p) = r.problem {
         diags.push(decode_diagnostic(btc_lang::db::file_id(db, f), p));
     }
     Ok(f)
@@ -75,42 +90,10 @@ pub fn load(
     path: &Path,
     diags: &mut Vec<Diagnostic>,
 ) -> anyhow::Result<FileId> {
-    let len = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
-    if len > btc_lang::source::MAX_FILE_BYTES as u64 {
-        let id = sources.add(path.display().to_string(), String::new());
-        diags.push(too_large(id, len));
-        return Ok(id);
-    }
-    let bytes = std::fs::read(path).map_err(|e| {
-        anyhow::anyhow!(
-            "[{}] cannot read `{}`: {e}",
-            codes::FILE_UNREADABLE.id,
-            path.display()
-        )
-    })?;
-    let (text, problem) = decode(&bytes);
-    let id = sources.add(path.display().to_string(), text);
-    match problem {
-        None => {}
-        Some(DecodeProblem::InvalidUtf8 { offset, byte }) => diags.push(
-            Diagnostic::error(
-                codes::FILE_ENCODING,
-                Span::new(id, offset, offset + 3),
-                format!(
-                    "this file is not UTF-8: byte 0x{byte:02X} at offset {offset} is not valid"
-                ),
-            )
-            .with_hint("save the file as UTF-8; btc read the rest with the bad bytes replaced"),
-        ),
-        Some(DecodeProblem::BadUtf16) => diags.push(
-            Diagnostic::error(
-                codes::FILE_ENCODING,
-                Span::new(id, 0, 0),
-                "this file starts with a UTF-16 byte-order mark but is not valid UTF-16",
-            )
-            .with_hint("save the file as UTF-8"),
-        ),
-        Some(DecodeProblem::TooLarge { bytes }) => diags.push(too_large(id, bytes as u64)),
+    let r = read(path)?;
+    let id = sources.add(path.display().to_string(), r.text);
+    if let Some(p) = r.problem {
+        diags.push(decode_diagnostic(id, p));
     }
     Ok(id)
 }
