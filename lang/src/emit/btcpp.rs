@@ -8,25 +8,29 @@
 
 use crate::ir::*;
 use crate::rules::ast::{ControlKind, DecoratorKind};
-use quick_xml::events::attributes::Attribute;
-use quick_xml::events::{BytesDecl, BytesEnd, BytesStart, Event};
-use quick_xml::Writer;
+use std::fmt::Write as _;
 
-/// Escapes text for an XML attribute value. Newlines and tabs become
+/// Whether a character must be escaped (or replaced) in an attribute value.
+fn needs_escape(c: char) -> bool {
+    matches!(
+        c,
+        '&' | '<' | '>' | '"' | '\'' | '\u{0}'..='\u{1F}' | '\u{FFFE}' | '\u{FFFF}'
+    )
+}
+
+/// Appends `s` escaped for an XML attribute value. Newlines and tabs become
 /// character references (a parser would fold them into spaces otherwise);
 /// characters XML 1.0 forbids become U+FFFD.
-pub fn escape_attr(s: &str) -> std::borrow::Cow<'_, str> {
-    let plain = |c: char| {
-        !matches!(
-            c,
-            '&' | '<' | '>' | '"' | '\'' | '\u{0}'..='\u{1F}' | '\u{FFFE}' | '\u{FFFF}'
-        )
-    };
-    if s.chars().all(plain) {
-        return std::borrow::Cow::Borrowed(s);
-    }
-    let mut out = String::with_capacity(s.len() + 8);
-    for c in s.chars() {
+pub fn escape_attr_into(out: &mut String, s: &str) {
+    // Runs of plain text are copied whole; only the rare specials are
+    // looked at one by one.
+    let mut plain_from = 0;
+    for (i, c) in s.char_indices() {
+        if !needs_escape(c) {
+            continue;
+        }
+        out.push_str(&s[plain_from..i]);
+        plain_from = i + c.len_utf8();
         match c {
             '&' => out.push_str("&amp;"),
             '<' => out.push_str("&lt;"),
@@ -36,10 +40,19 @@ pub fn escape_attr(s: &str) -> std::borrow::Cow<'_, str> {
             '\n' => out.push_str("&#10;"),
             '\r' => out.push_str("&#13;"),
             '\t' => out.push_str("&#9;"),
-            c if (c as u32) < 0x20 || c == '\u{FFFE}' || c == '\u{FFFF}' => out.push('\u{FFFD}'),
-            c => out.push(c),
+            _ => out.push('\u{FFFD}'),
         }
     }
+    out.push_str(&s[plain_from..]);
+}
+
+/// [`escape_attr_into`] as a value; borrows when nothing needs escaping.
+pub fn escape_attr(s: &str) -> std::borrow::Cow<'_, str> {
+    if !s.chars().any(needs_escape) {
+        return std::borrow::Cow::Borrowed(s);
+    }
+    let mut out = String::with_capacity(s.len() + 8);
+    escape_attr_into(&mut out, s);
     std::borrow::Cow::Owned(out)
 }
 
@@ -62,72 +75,122 @@ pub fn element_name(id: &str) -> String {
     out
 }
 
+/// An indenting XML writer straight into a `String`: elements are opened,
+/// given attributes one at a time and closed, with no per-element
+/// allocation (a 100,000-step plan writes a million elements).
 struct Xml {
-    w: Writer<Vec<u8>>,
+    out: String,
+    depth: usize,
 }
 
 impl Xml {
-    fn start(&mut self, name: &str, attrs: &[(&str, String)], empty: bool) {
-        let mut e = BytesStart::new(name);
-        for (k, v) in attrs {
-            let escaped = escape_attr(v);
-            e.push_attribute(Attribute::from((k.as_bytes(), escaped.as_bytes())));
+    fn new(capacity: usize) -> Xml {
+        let mut out = String::with_capacity(capacity);
+        out.push_str(r#"<?xml version="1.0" encoding="UTF-8"?>"#);
+        Xml { out, depth: 0 }
+    }
+
+    fn newline(&mut self) {
+        self.out.push('\n');
+        for _ in 0..self.depth {
+            self.out.push_str("  ");
         }
-        let ev = if empty {
-            Event::Empty(e)
+    }
+
+    /// `<name` on a new line; attributes follow, then [`Xml::close`].
+    fn open(&mut self, name: &str) -> &mut Xml {
+        self.newline();
+        self.out.push('<');
+        self.out.push_str(name);
+        self
+    }
+
+    fn attr(&mut self, key: &str, value: &str) -> &mut Xml {
+        self.out.push(' ');
+        self.out.push_str(key);
+        self.out.push_str("=\"");
+        escape_attr_into(&mut self.out, value);
+        self.out.push('"');
+        self
+    }
+
+    /// An attribute whose value is written by `f` (unescaped: only for
+    /// numbers and already-safe text).
+    fn attr_with(&mut self, key: &str, f: impl FnOnce(&mut String)) -> &mut Xml {
+        self.out.push(' ');
+        self.out.push_str(key);
+        self.out.push_str("=\"");
+        f(&mut self.out);
+        self.out.push('"');
+        self
+    }
+
+    fn name(&mut self, name: &Option<String>) -> &mut Xml {
+        if let Some(n) = name {
+            self.attr("name", n);
+        }
+        self
+    }
+
+    fn port(&mut self, p: &Port) -> &mut Xml {
+        match &p.value {
+            PortValue::Text(s) => self.attr(&p.name, s),
+            PortValue::Param(s) => {
+                self.out.push(' ');
+                self.out.push_str(&p.name);
+                self.out.push_str("=\"{");
+                escape_attr_into(&mut self.out, s);
+                self.out.push_str("}\"");
+                self
+            }
+            other => self.attr(&p.name, &other.to_text()),
+        }
+    }
+
+    /// Ends the start tag: `/>` when `empty`, else `>` and a level deeper.
+    fn close(&mut self, empty: bool) {
+        if empty {
+            self.out.push_str("/>");
         } else {
-            Event::Start(e)
-        };
-        self.w
-            .write_event(ev)
-            .expect("writing to a Vec cannot fail");
+            self.out.push('>');
+            self.depth += 1;
+        }
     }
 
     fn end(&mut self, name: &str) {
-        self.w
-            .write_event(Event::End(BytesEnd::new(name)))
-            .expect("writing to a Vec cannot fail");
+        self.depth -= 1;
+        self.newline();
+        self.out.push_str("</");
+        self.out.push_str(name);
+        self.out.push('>');
     }
 }
 
-fn control_tag(c: ControlKind) -> (&'static str, Vec<(&'static str, String)>) {
+fn control_tag(c: ControlKind) -> &'static str {
     match c {
-        ControlKind::Sequence => ("Sequence", vec![]),
-        ControlKind::ReactiveSequence => ("ReactiveSequence", vec![]),
-        ControlKind::Fallback => ("Fallback", vec![]),
-        ControlKind::ReactiveFallback => ("ReactiveFallback", vec![]),
-        ControlKind::Parallel { success, failure } => (
-            "Parallel",
-            vec![
-                ("success_count", success.to_string()),
-                ("failure_count", failure.to_string()),
-            ],
-        ),
+        ControlKind::Sequence => "Sequence",
+        ControlKind::ReactiveSequence => "ReactiveSequence",
+        ControlKind::Fallback => "Fallback",
+        ControlKind::ReactiveFallback => "ReactiveFallback",
+        ControlKind::Parallel { .. } => "Parallel",
     }
 }
 
-fn decorator_tag(d: DecoratorKind) -> (&'static str, Vec<(&'static str, String)>) {
+fn decorator_tag(d: DecoratorKind) -> &'static str {
     match d {
-        DecoratorKind::Retry { times } => (
-            "RetryUntilSuccessful",
-            vec![("num_attempts", times.to_string())],
-        ),
-        DecoratorKind::Repeat { times } => ("Repeat", vec![("num_cycles", times.to_string())]),
-        DecoratorKind::Timeout { ms } => ("Timeout", vec![("msec", ms.to_string())]),
-        DecoratorKind::Inverter => ("Inverter", vec![]),
-        DecoratorKind::ForceSuccess => ("ForceSuccess", vec![]),
-        DecoratorKind::ForceFailure => ("ForceFailure", vec![]),
+        DecoratorKind::Retry { .. } => "RetryUntilSuccessful",
+        DecoratorKind::Repeat { .. } => "Repeat",
+        DecoratorKind::Timeout { .. } => "Timeout",
+        DecoratorKind::Inverter => "Inverter",
+        DecoratorKind::ForceSuccess => "ForceSuccess",
+        DecoratorKind::ForceFailure => "ForceFailure",
     }
 }
 
-fn with_name(
-    mut attrs: Vec<(&'static str, String)>,
-    name: &Option<String>,
-) -> Vec<(&'static str, String)> {
-    if let Some(n) = name {
-        attrs.insert(0, ("name", n.clone()));
-    }
-    attrs
+fn number(x: &mut Xml, key: &str, n: impl std::fmt::Display) {
+    x.attr_with(key, |out| {
+        let _ = write!(out, "{n}");
+    });
 }
 
 fn node(x: &mut Xml, n: &Node, ir: &TreeIr) {
@@ -137,13 +200,16 @@ fn node(x: &mut Xml, n: &Node, ir: &TreeIr) {
             name,
             children,
         } => {
-            let (tag, attrs) = control_tag(*control);
-            let attrs = with_name(attrs, name);
+            let tag = control_tag(*control);
+            x.open(tag).name(name);
+            if let ControlKind::Parallel { success, failure } = control {
+                number(x, "success_count", success);
+                number(x, "failure_count", failure);
+            }
+            x.close(children.is_empty());
             if children.is_empty() {
-                x.start(tag, &attrs, true);
                 return;
             }
-            x.start(tag, &attrs, false);
             for c in children {
                 node(x, c, ir);
             }
@@ -154,50 +220,54 @@ fn node(x: &mut Xml, n: &Node, ir: &TreeIr) {
             name,
             child,
         } => {
-            let (tag, attrs) = decorator_tag(*decorator);
-            x.start(tag, &with_name(attrs, name), false);
+            let tag = decorator_tag(*decorator);
+            x.open(tag).name(name);
+            match decorator {
+                DecoratorKind::Retry { times } => number(x, "num_attempts", times),
+                DecoratorKind::Repeat { times } => number(x, "num_cycles", times),
+                DecoratorKind::Timeout { ms } => number(x, "msec", ms),
+                _ => {}
+            }
+            x.close(false);
             node(x, child, ir);
             x.end(tag);
         }
         Node::Leaf {
             id, name, ports, ..
         } => {
-            let tag = element_name(id);
-            let mut attrs: Vec<(&str, String)> = Vec::new();
-            if let Some(n) = name {
-                attrs.push(("name", n.clone()));
-            }
+            x.open(&element_name(id)).name(name);
             for p in ports {
-                attrs.push((p.name.as_str(), p.value.to_text()));
+                x.port(p);
             }
-            x.start(&tag, &attrs, true);
+            x.close(true);
         }
         Node::SubTree { id, ports } => {
-            let mut attrs: Vec<(&str, String)> = vec![("ID", id.clone())];
+            x.open("SubTree").attr("ID", id);
             for p in ports {
-                attrs.push((p.name.as_str(), p.value.to_text()));
+                x.port(p);
             }
-            x.start("SubTree", &attrs, true);
+            x.close(true);
         }
         Node::Step { step, child } => {
             let info = ir.steps.get(*step);
-            let name = info.map_or_else(
-                || format!("step {}", step + 1),
-                |s| format!("step {}: {}", step + 1, s.display()),
-            );
-            let attrs = vec![
-                ("name", name),
-                ("step", (step + 1).to_string()),
-                (
-                    "start_effect",
-                    info.and_then(|s| s.eff_start.clone()).unwrap_or_default(),
-                ),
-                (
-                    "end_effect",
-                    info.and_then(|s| s.eff_end.clone()).unwrap_or_default(),
-                ),
-            ];
-            x.start("KbStep", &attrs, false);
+            x.open("KbStep").attr_with("name", |out| {
+                let _ = write!(out, "step {}", step + 1);
+                if let Some(s) = info {
+                    out.push_str(": (");
+                    escape_attr_into(out, &s.action);
+                    for a in &s.args {
+                        out.push(' ');
+                        escape_attr_into(out, a);
+                    }
+                    out.push(')');
+                }
+            });
+            number(x, "step", step + 1);
+            let start = info.and_then(|s| s.eff_start.as_deref()).unwrap_or("");
+            let end = info.and_then(|s| s.eff_end.as_deref()).unwrap_or("");
+            x.attr("start_effect", start)
+                .attr("end_effect", end)
+                .close(false);
             node(x, child, ir);
             x.end("KbStep");
         }
@@ -218,20 +288,14 @@ pub fn emit(ir: &TreeIr, inline: bool) -> String {
     // Sized up front: growing a buffer of tens of megabytes by doubling
     // costs more (copies, fresh pages) than writing it.
     let estimate = 4096 + ir.steps.len() * 320 + ir.trees.len() * 2048;
-    let mut x = Xml {
-        w: Writer::new_with_indent(Vec::with_capacity(estimate), b' ', 2),
-    };
-    x.w.write_event(Event::Decl(BytesDecl::new("1.0", Some("UTF-8"), None)))
-        .expect("vec");
-    x.start(
-        "root",
-        &[
-            ("BTCPP_format", "4".into()),
-            ("main_tree_to_execute", ir.main_tree.clone()),
-        ],
-        false,
-    );
-    x.start("BehaviorTree", &[("ID", ir.main_tree.clone())], false);
+    let mut x = Xml::new(estimate);
+    x.open("root")
+        .attr("BTCPP_format", "4")
+        .attr("main_tree_to_execute", &ir.main_tree)
+        .close(false);
+    x.open("BehaviorTree")
+        .attr("ID", &ir.main_tree)
+        .close(false);
     if inline {
         node(&mut x, &ir.inlined(), ir);
     } else {
@@ -240,86 +304,79 @@ pub fn emit(ir: &TreeIr, inline: bool) -> String {
     x.end("BehaviorTree");
     if !inline {
         for t in &ir.trees {
-            x.start("BehaviorTree", &[("ID", t.id.clone())], false);
+            x.open("BehaviorTree").attr("ID", &t.id).close(false);
             node(&mut x, &t.root, ir);
             x.end("BehaviorTree");
         }
     }
-    x.start("TreeNodesModel", &[], false);
+    x.open("TreeNodesModel").close(false);
     for m in &ir.nodes {
         let tag = match m.kind {
             LeafKind::Action => "Action",
             LeafKind::Condition => "Condition",
         };
-        let mut attrs = vec![("ID", element_name(&m.id))];
+        x.open(tag).attr("ID", &element_name(&m.id));
         if let Some(f) = &m.formula {
-            attrs.push(("description", format!("holds when {f}")));
+            x.attr("description", &format!("holds when {f}"));
         }
+        x.close(m.ports.is_empty());
         if m.ports.is_empty() {
-            x.start(tag, &attrs, true);
             continue;
         }
-        x.start(tag, &attrs, false);
         for p in &m.ports {
             let kind = match p.direction {
                 PortDirection::Input => "input_port",
                 PortDirection::Output => "output_port",
             };
-            let mut pa = vec![
-                ("name", p.name.clone()),
-                ("type", port_type(&p.ty).to_owned()),
-            ];
+            x.open(kind)
+                .attr("name", &p.name)
+                .attr("type", port_type(&p.ty));
             if !matches!(p.ty.as_str(), "int" | "float" | "bool" | "string") {
-                pa.push(("description", format!("a PDDL object of type {}", p.ty)));
+                x.attr("description", &format!("a PDDL object of type {}", p.ty));
             }
-            x.start(kind, &pa, true);
+            x.close(true);
         }
         x.end(tag);
     }
     // The step decorator btc emits around every plan step.
     if ir.steps.iter().any(|s| !s.skipped) {
-        x.start("Decorator", &[("ID", "KbStep".into()), ("description", "a plan step: applies its PDDL effects to the KB when it starts and when its child succeeds".into())], false);
-        x.start(
-            "input_port",
-            &[("name", "step".into()), ("type", "int".into())],
-            true,
-        );
-        x.start(
-            "input_port",
-            &[
-                ("name", "start_effect".into()),
-                ("type", "std::string".into()),
-            ],
-            true,
-        );
-        x.start(
-            "input_port",
-            &[
-                ("name", "end_effect".into()),
-                ("type", "std::string".into()),
-            ],
-            true,
-        );
+        x.open("Decorator")
+            .attr("ID", "KbStep")
+            .attr(
+                "description",
+                "a plan step: applies its PDDL effects to the KB when it starts and when its child succeeds",
+            )
+            .close(false);
+        for (name, ty) in [
+            ("step", "int"),
+            ("start_effect", "std::string"),
+            ("end_effect", "std::string"),
+        ] {
+            x.open("input_port")
+                .attr("name", name)
+                .attr("type", ty)
+                .close(true);
+        }
         x.end("Decorator");
     }
     if !inline {
         for t in &ir.trees {
+            x.open("SubTree")
+                .attr("ID", &t.id)
+                .close(t.params.is_empty());
             if t.params.is_empty() {
-                x.start("SubTree", &[("ID", t.id.clone())], true);
                 continue;
             }
-            x.start("SubTree", &[("ID", t.id.clone())], false);
             for p in &t.params {
-                x.start("input_port", &[("name", p.clone())], true);
+                x.open("input_port").attr("name", p).close(true);
             }
             x.end("SubTree");
         }
     }
     x.end("TreeNodesModel");
     x.end("root");
-    let mut out = String::from_utf8(x.w.into_inner()).expect("we wrote UTF-8");
-    out.push('\n');
-    out
+    x.out.push('\n');
+    x.out
 }
 
 #[cfg(test)]
