@@ -7,8 +7,8 @@ use crate::diagnostic::{codes, Diagnostic};
 use crate::pddl::{ast::Domain, ast::Problem, DomainIndex, ProblemIndex};
 use crate::pipeline::{domain_unit_from, problem_unit_from};
 use crate::rules::check::{check_file, check_item, Decls, DomainCtx};
-use crate::rules::parse::shift;
-use crate::rules::{parse_rules, ImportTarget, Item, ItemNode, ParsedRules};
+use crate::rules::parse::{parse_item_text, parse_rules_with, shift};
+use crate::rules::{ImportTarget, Item, ItemNode, ParsedRules};
 use crate::source::{FileId, Sources, Span};
 use salsa::plumbing::AsId;
 use salsa::Setter;
@@ -146,10 +146,28 @@ pub fn file_id(_db: &dyn Db, f: SourceFile) -> FileId {
     f.as_id().index()
 }
 
-/// A rules file parsed.
+/// A rules file parsed. Items are parsed through [`parsed_item`], so an
+/// edit re-parses only the items whose text it changed.
 #[salsa::tracked(returns(ref))]
 pub fn parsed_rules(db: &dyn Db, file: SourceFile) -> ParsedRules {
-    parse_rules(file.text(db), file_id(db, file))
+    parse_rules_with(file.text(db), file_id(db, file), |text| {
+        parsed_item(db, ItemText::new(db, file, text.to_owned())).clone()
+    })
+}
+
+/// The text of one top-level item of a rules file.
+#[salsa::interned(debug)]
+pub struct ItemText<'db> {
+    #[returns(copy)]
+    pub file: SourceFile,
+    #[returns(ref)]
+    pub text: String,
+}
+
+/// One item parsed, with spans relative to its start.
+#[salsa::tracked(returns(ref))]
+pub fn parsed_item<'db>(db: &'db dyn Db, item: ItemText<'db>) -> (Item, Vec<Diagnostic>) {
+    parse_item_text(item.text(db), file_id(db, item.file(db)))
 }
 
 /// One top-level item. Identified by its file and head (kind and name or
@@ -533,6 +551,11 @@ mod tests {
             .filter(|l| l.starts_with("item_diagnostics"))
             .count();
         assert_eq!(rechecked, 1, "{log:#?}");
+        let reparsed = log.iter().filter(|l| l.starts_with("parsed_item")).count();
+        assert_eq!(
+            reparsed, 1,
+            "only the edited item is parsed again: {log:#?}"
+        );
         assert_eq!(after.len(), 1, "{after:?}");
         assert!(
             after[0].ends_with(":27:45: error[R006]: `?destination` is not bound here"),

@@ -37,12 +37,24 @@ pub struct ParsedRules {
 }
 
 pub fn parse_rules(text: &str, file: FileId) -> ParsedRules {
+    parse_rules_with(text, file, |item| parse_item_text(item, file))
+}
+
+/// [`parse_rules`] with each item's text parsed by `parse_item`, which the
+/// database memoizes: an edit re-lexes the file to cut it into items but
+/// parses only the items whose text changed.
+pub fn parse_rules_with(
+    text: &str,
+    file: FileId,
+    mut parse_item: impl FnMut(&str) -> (Item, Vec<Diagnostic>),
+) -> ParsedRules {
     let lexed = lex(text, file);
     let mut diagnostics = lexed.diagnostics;
     let mut items = Vec::new();
     for chunk in split_items(&lexed.tokens, text) {
         let offset = lexed.tokens[chunk.start].1.start;
-        let (item, diags) = parse_item(&lexed.tokens[chunk], offset, file);
+        let end = lexed.tokens[chunk.end - 1].1.end;
+        let (item, diags) = parse_item(&text[offset as usize..end as usize]);
         diagnostics.extend(diags.into_iter().map(|d| shift(d, file, offset)));
         items.push(ItemNode { offset, item });
     }
@@ -51,6 +63,15 @@ pub fn parse_rules(text: &str, file: FileId) -> ParsedRules {
         comments: lexed.comments,
         diagnostics,
     }
+}
+
+/// Parses the text of one item (cut by [`parse_rules_with`]), with spans
+/// relative to its start. The item starts with a token, outside any comment
+/// or string, so lexing it alone gives the same tokens as in the file; the
+/// file's lexer has reported lexical errors already, so these are dropped.
+pub fn parse_item_text(text: &str, file: FileId) -> (Item, Vec<Diagnostic>) {
+    let lexed = lex(text, file);
+    parse_item(&lexed.tokens, 0, file)
 }
 
 /// Moves a diagnostic's spans in `file` by `offset` (from item-relative to
