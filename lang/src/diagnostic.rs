@@ -24,6 +24,15 @@ pub struct Label {
     pub message: String,
 }
 
+/// A machine-applicable repair: replace `span` with `replacement`. The
+/// language server offers these as quick fixes.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Fix {
+    pub title: String,
+    pub span: Span,
+    pub replacement: String,
+}
+
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Diagnostic {
     pub code: &'static str,
@@ -33,6 +42,9 @@ pub struct Diagnostic {
     /// Secondary places, e.g. the earlier definition of a duplicate.
     pub labels: Vec<Label>,
     pub hint: Option<String>,
+    /// Boxed: most diagnostics have none, and `Result<_, Diagnostic>` stays small.
+    #[serde(skip_serializing_if = "<[Fix]>::is_empty")]
+    pub fixes: Box<[Fix]>,
 }
 
 impl Diagnostic {
@@ -44,6 +56,7 @@ impl Diagnostic {
             span,
             labels: Vec::new(),
             hint: None,
+            fixes: Box::default(),
         }
     }
 
@@ -57,6 +70,42 @@ impl Diagnostic {
     pub fn with_hint(mut self, hint: impl Into<String>) -> Diagnostic {
         self.hint = Some(hint.into());
         self
+    }
+
+    pub fn with_fix(
+        mut self,
+        title: impl Into<String>,
+        span: Span,
+        replacement: impl Into<String>,
+    ) -> Diagnostic {
+        let mut fixes = std::mem::take(&mut self.fixes).into_vec();
+        fixes.push(Fix {
+            title: title.into(),
+            span,
+            replacement: replacement.into(),
+        });
+        self.fixes = fixes.into_boxed_slice();
+        self
+    }
+
+    /// "did you mean `X`?" with the replacement of the diagnostic's own span
+    /// by `X` as a fix; `otherwise` is the hint when there is no candidate.
+    pub fn suggest(
+        self,
+        candidate: Option<String>,
+        otherwise: impl FnOnce() -> String,
+    ) -> Diagnostic {
+        match candidate {
+            Some(c) => {
+                let span = self.span;
+                self.with_hint(format!("did you mean `{c}`?")).with_fix(
+                    format!("change to `{c}`"),
+                    span,
+                    c,
+                )
+            }
+            None => self.with_hint(otherwise()),
+        }
     }
 
     pub fn with_label(mut self, span: Span, message: impl Into<String>) -> Diagnostic {

@@ -5,7 +5,7 @@
 
 use super::ast::*;
 use super::matching::{bind_params, match_name};
-use crate::diagnostic::{closest, codes, did_you_mean, Diagnostic};
+use crate::diagnostic::{closest, codes, Diagnostic};
 use crate::pddl::ast::{Domain, Effect, Formula};
 use crate::pddl::check::{check_effect_in, check_formula_in, DomainIndex, ProblemIndex};
 use crate::pddl::types::TypeId;
@@ -175,15 +175,16 @@ impl Tcx<'_> {
 
     fn call(&mut self, name: &Ident, args: &[Arg], span: Span) {
         let Some(ports) = self.decls.ports(&name.text) else {
-            let hint = did_you_mean(&name.text, self.decls.callables())
-                .unwrap_or_else(|| format!("declare it: `action {}(...)`", name.text));
+            let candidate = closest(&name.text, self.decls.callables()).map(str::to_owned);
             self.err(
                 Diagnostic::error(
                     codes::R_UNKNOWN_NODE,
                     name.span,
                     format!("no node or tree is called `{}`", name.text),
                 )
-                .with_hint(hint),
+                .suggest(candidate, || {
+                    format!("declare it: `action {}(...)`", name.text)
+                }),
             );
             for a in args {
                 self.value(&a.value);
@@ -195,23 +196,24 @@ impl Tcx<'_> {
         for a in args {
             let vt = self.value(&a.value);
             let Some(port) = ports.iter().find(|p| p.name.text == a.port.text) else {
-                let hint = did_you_mean(&a.port.text, ports.iter().map(|p| p.name.text.as_str()))
-                    .unwrap_or_else(|| {
-                        let names: Vec<String> =
-                            ports.iter().map(|p| format!("`{}`", p.name.text)).collect();
-                        if names.is_empty() {
-                            format!("`{}` has no ports", name.text)
-                        } else {
-                            format!("its ports are {}", names.join(", "))
-                        }
-                    });
+                let candidate = closest(&a.port.text, ports.iter().map(|p| p.name.text.as_str()))
+                    .map(str::to_owned);
+                let otherwise = || {
+                    let names: Vec<String> =
+                        ports.iter().map(|p| format!("`{}`", p.name.text)).collect();
+                    if names.is_empty() {
+                        format!("`{}` has no ports", name.text)
+                    } else {
+                        format!("its ports are {}", names.join(", "))
+                    }
+                };
                 self.err(
                     Diagnostic::error(
                         codes::R_UNKNOWN_PORT,
                         a.port.span,
                         format!("`{}` has no port `{}`", name.text, a.port.text),
                     )
-                    .with_hint(hint),
+                    .suggest(candidate, otherwise),
                 );
                 continue;
             };
@@ -278,18 +280,17 @@ impl Tcx<'_> {
         match self.vars.iter().find(|(v, _)| *v == name.text) {
             Some((_, t)) => t.clone(),
             None => {
-                let hint = closest(&name.text, self.vars.iter().map(|(v, _)| v.as_str()))
-                    .map(|c| format!("did you mean `?{c}`?"))
-                    .unwrap_or_else(|| {
-                        "variables come from the rule's pattern (or the tree's ports)".into()
-                    });
+                let candidate = closest(&name.text, self.vars.iter().map(|(v, _)| v.as_str()))
+                    .map(|c| format!("?{c}"));
                 self.err(
                     Diagnostic::error(
                         codes::R_UNBOUND,
                         name.span,
                         format!("`?{}` is not bound here", name.text),
                     )
-                    .with_hint(hint),
+                    .suggest(candidate, || {
+                        "variables come from the rule's pattern (or the tree's ports)".into()
+                    }),
                 );
                 None
             }
@@ -300,17 +301,17 @@ impl Tcx<'_> {
         match self.captures.iter().find(|(c, _)| *c == name.text) {
             Some((_, vals)) => Some(vals.clone()),
             None => {
-                let hint = did_you_mean(&name.text, self.captures.iter().map(|(c, _)| c.as_str()))
-                    .unwrap_or_else(|| {
-                        "captures come from `{name}` parts of the rule's pattern".into()
-                    });
+                let candidate = closest(&name.text, self.captures.iter().map(|(c, _)| c.as_str()))
+                    .map(str::to_owned);
                 self.err(
                     Diagnostic::error(
                         codes::R_UNBOUND,
                         name.span,
                         format!("`{}` is not a capture of this rule", name.text),
                     )
-                    .with_hint(hint),
+                    .suggest(candidate, || {
+                        "captures come from `{name}` parts of the rule's pattern".into()
+                    }),
                 );
                 None
             }
@@ -340,15 +341,17 @@ impl Tcx<'_> {
 
     fn lookup(&mut self, table: &Ident, key: &Value, span: Span) -> VType {
         let Some(t) = self.decls.tables.get(&table.text).cloned() else {
-            let hint = did_you_mean(&table.text, self.decls.tables.keys().map(String::as_str))
-                .unwrap_or_else(|| format!("declare it: `table {} {{ KEY: value }}`", table.text));
+            let candidate = closest(&table.text, self.decls.tables.keys().map(String::as_str))
+                .map(str::to_owned);
             self.err(
                 Diagnostic::error(
                     codes::R_UNKNOWN_TABLE,
                     table.span,
                     format!("no table is called `{}`", table.text),
                 )
-                .with_hint(hint),
+                .suggest(candidate, || {
+                    format!("declare it: `table {} {{ KEY: value }}`", table.text)
+                }),
             );
             self.value(key);
             return VType::Unknown;
@@ -452,15 +455,20 @@ impl Tcx<'_> {
                                     .collect::<Vec<_>>()
                             })
                             .unwrap_or_default();
-                        let hint =
-                            did_you_mean(&obj_l, known.iter().copied()).unwrap_or_else(|| {
-                                "it names no object of the problem and no constant of the domain"
-                                    .to_owned()
-                            });
-                        self.err(
-                            Diagnostic::error(codes::R_UNKNOWN_OBJECT, value.span(), format!("`{obj}` is not among the problem's objects or the domain's constants"))
-                                .with_hint(hint),
-                        );
+                        // The fix rewrites the whole literal, quotes included.
+                        let candidate = closest(&obj_l, known.iter().copied());
+                        let mut d = Diagnostic::error(codes::R_UNKNOWN_OBJECT, value.span(), format!("`{obj}` is not among the problem's objects or the domain's constants"));
+                        d = match candidate {
+                            Some(c) => d.with_hint(format!("did you mean `{c}`?")).with_fix(
+                                format!("change to `{c}`"),
+                                value.span(),
+                                format!("{c:?}"),
+                            ),
+                            None => d.with_hint(
+                                "it names no object of the problem and no constant of the domain",
+                            ),
+                        };
+                        self.err(d);
                         return;
                     }
                 }
@@ -680,16 +688,16 @@ fn port_type_diags(ports: &[PortDecl], ctx: Option<DomainCtx>) -> Vec<Diagnostic
                     .names()
                     .chain(BASIC_TYPES.iter().copied())
                     .collect();
-                let hint = did_you_mean(ty, candidates.iter().copied()).unwrap_or_else(|| {
-                    "port types are the domain's types or string, int, float, bool".into()
-                });
+                let candidate = closest(ty, candidates.iter().copied()).map(str::to_owned);
                 diags.push(
                     Diagnostic::error(
                         codes::R_UNKNOWN_TYPE,
                         p.ty.span,
                         format!("`{ty}` is neither a type of the domain nor a basic type"),
                     )
-                    .with_hint(hint),
+                    .suggest(candidate, || {
+                        "port types are the domain's types or string, int, float, bool".into()
+                    }),
                 );
             }
         }
@@ -769,8 +777,8 @@ fn check_rule(r: &Rule, decls: &Decls, ctx: Option<DomainCtx>) -> Vec<Diagnostic
                             format!("`{}` is not a type of the domain", ty.text),
                         );
                         push(
-                            match did_you_mean(&ty.text.to_lowercase(), c.index.types.names()) {
-                                Some(h) => d.with_hint(h),
+                            match closest(&ty.text.to_lowercase(), c.index.types.names()) {
+                                Some(t) => d.suggest(Some(t.to_owned()), String::new),
                                 None => d,
                             },
                             &mut diags,
@@ -816,21 +824,21 @@ fn check_rule(r: &Rule, decls: &Decls, ctx: Option<DomainCtx>) -> Vec<Diagnostic
     let matched = rule_actions(r, decls, c.domain);
     if matched.is_empty() {
         let written = r.pattern.name_text();
-        let hint = did_you_mean(
+        let candidate = closest(
             &written.to_lowercase(),
             c.domain.actions.iter().map(|a| a.name.as_str()),
         )
-        .unwrap_or_else(|| {
-            let names: Vec<&str> = c.domain.actions.iter().map(|a| a.name.as_str()).collect();
-            format!("the domain's actions are {}", names.join(", "))
-        });
+        .map(str::to_owned);
         push(
             Diagnostic::error(
                 codes::R_UNKNOWN_ACTION,
                 r.pattern.name_span(),
                 format!("the domain has no action `{written}`"),
             )
-            .with_hint(hint),
+            .suggest(candidate, || {
+                let names: Vec<&str> = c.domain.actions.iter().map(|a| a.name.as_str()).collect();
+                format!("the domain's actions are {}", names.join(", "))
+            }),
             &mut diags,
         );
         return diags;
@@ -972,7 +980,8 @@ fn compare_effect(
         .with_label(action.name.span, "the PDDL action")
         .with_hint(format!(
             "the PDDL effect in this rule's variables: `effect {rewritten}`"
-        )),
+        ))
+        .with_fix("write the PDDL action's effect", effect.span(), rewritten),
     )
 }
 

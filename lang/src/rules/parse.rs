@@ -87,6 +87,9 @@ pub fn shift(mut d: Diagnostic, file: FileId, offset: u32) -> Diagnostic {
     for l in &mut d.labels {
         mv(&mut l.span);
     }
+    for f in &mut d.fixes {
+        mv(&mut f.span);
+    }
     d
 }
 
