@@ -96,6 +96,8 @@ enum Command {
         #[arg(long)]
         check: bool,
     },
+    /// Run the language server on stdin/stdout (for editors).
+    Lsp,
     /// Check that a plan is valid: every step applicable, the goal reached.
     Validate {
         domain: PathBuf,
@@ -164,6 +166,9 @@ fn main() -> ExitCode {
             format,
         }),
         Command::Fmt { files, check } => rules_cmd::fmt(&files, check),
+        Command::Lsp => btc_lsp::run_stdio()
+            .map(|()| ExitCode::SUCCESS)
+            .map_err(anyhow::Error::from),
         Command::Validate {
             domain,
             problem,

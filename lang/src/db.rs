@@ -110,6 +110,16 @@ impl Database {
         f
     }
 
+    /// Forgets a file (deleted on disk); rules that name it report it missing.
+    pub fn remove_file(&mut self, path: &str) {
+        let ws = self.workspace();
+        if ws.files(self).contains_key(path) {
+            let mut files = ws.files(self).clone();
+            files.remove(path);
+            ws.set_files(self).to(files);
+        }
+    }
+
     pub fn file(&self, path: &str) -> Option<SourceFile> {
         self.workspace().files(self).get(path).copied()
     }

@@ -1,0 +1,163 @@
+//! One rules file seen with everything the editor features need: its text
+//! and tokens, its parsed items, the declarations in scope, its domain.
+
+use crate::convert::LineIndex;
+use crate::syntax::FileSyntax;
+use crate::syntax::Tokens;
+use crate::workspace::Workspace;
+use btc_lang::db::{checked_domain, declarations, import_closure, parsed_rules, SourceFile};
+use btc_lang::pddl::ast::{Action, Domain};
+use btc_lang::pddl::DomainIndex;
+use btc_lang::rules::ast::{Item, ItemNode, Rule};
+use btc_lang::rules::check::{matched_actions, Decls};
+use btc_lang::source::Span;
+use tower_lsp::lsp_types::{Location, Range, Url};
+
+pub struct Analysis<'a> {
+    pub ws: &'a Workspace,
+    pub file: SourceFile,
+    pub text: &'a str,
+    pub items: &'a [ItemNode],
+    pub decls: &'a Decls,
+    pub domain: Option<(SourceFile, &'a Domain, &'a DomainIndex)>,
+    pub syntax: FileSyntax<'a>,
+}
+
+/// A place in some file of the workspace.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Place {
+    pub file: SourceFile,
+    pub span: Span,
+}
+
+impl<'a> Analysis<'a> {
+    pub fn new(ws: &'a Workspace, path: &str) -> Option<Analysis<'a>> {
+        if !Workspace::is_rules(path) {
+            return None;
+        }
+        let file = ws.file(path)?;
+        let db = &ws.db;
+        let text = file.text(db).as_str();
+        let items = parsed_rules(db, file).items.as_slice();
+        let decls = declarations(db, file);
+        let domain = btc_lang::db::domain_file(db, file).and_then(|d| {
+            let cd = checked_domain(db, d);
+            cd.domain.as_ref().map(|dom| (d, dom, &cd.index))
+        });
+        Some(Analysis {
+            ws,
+            file,
+            text,
+            items,
+            decls,
+            domain,
+            syntax: FileSyntax {
+                text,
+                tokens: Tokens::new(text),
+                items,
+                decls,
+                dix: domain.map(|d| d.2),
+            },
+        })
+    }
+
+    pub fn line_index(&self) -> LineIndex<'a> {
+        LineIndex::new(self.text)
+    }
+
+    /// An LSP location of a place (`None` for stdlib files, which have no
+    /// file on disk).
+    pub fn location(&self, p: &Place) -> Option<Location> {
+        let path = p.file.path(&self.ws.db);
+        let uri = Url::from_file_path(path).ok()?;
+        let text = p.file.text(&self.ws.db);
+        Some(Location::new(uri, LineIndex::new(text).range(p.span)))
+    }
+
+    pub fn range(&self, span: Span) -> Range {
+        self.line_index().range(span)
+    }
+
+    /// The rule of item `item`, if it is one.
+    pub fn rule(&self, item: usize) -> Option<&'a Rule> {
+        match &self.items.get(item)?.item {
+            Item::Rule(r) => Some(r),
+            _ => None,
+        }
+    }
+
+    /// The domain actions a rule's pattern matches.
+    pub fn actions_of(&self, r: &Rule) -> Vec<&'a Action> {
+        match self.domain {
+            Some((_, d, _)) => matched_actions(&r.pattern, d)
+                .into_iter()
+                .map(|(a, _)| a)
+                .collect(),
+            None => Vec::new(),
+        }
+    }
+
+    /// The PDDL type(s) of a rule's `?var`: the parameter at its position in
+    /// every action the rule matches.
+    pub fn var_types(&self, r: &Rule, var: &str) -> Vec<String> {
+        let Some(pos) = r.pattern.params.iter().position(|p| p.var.text == var) else {
+            return Vec::new();
+        };
+        let mut out: Vec<String> = Vec::new();
+        for a in self.actions_of(r) {
+            if let Some(p) = a.params.get(pos) {
+                let t = p.ty.to_string();
+                if !out.contains(&t) {
+                    out.push(t);
+                }
+            }
+        }
+        out
+    }
+
+    /// Files in scope: this one and its imports.
+    pub fn closure(&self) -> &'a [SourceFile] {
+        &import_closure(&self.ws.db, self.file).0
+    }
+
+    /// The declaration of a node, tree or table named `name` (`table` says
+    /// which namespace), in this file or an import.
+    pub fn declaration(&self, name: &str, table: bool) -> Option<(Place, &'a Item)> {
+        for f in self.closure() {
+            for n in &parsed_rules(&self.ws.db, *f).items {
+                let found = match &n.item {
+                    Item::Node(d) if !table && d.name.text == name => Some(d.name.span),
+                    Item::Tree(d) if !table && d.name.text == name => Some(d.name.span),
+                    Item::Table(d) if table && d.name.text == name => Some(d.name.span),
+                    _ => None,
+                };
+                if let Some(s) = found {
+                    return Some((
+                        Place {
+                            file: *f,
+                            span: shift(s, n.offset),
+                        },
+                        &n.item,
+                    ));
+                }
+            }
+        }
+        None
+    }
+
+    /// The source text of an item declared in `file` at `span` (item
+    /// relative spans already made absolute).
+    pub fn source_of(&self, file: SourceFile, span: Span) -> &'a str {
+        let text = file.text(&self.ws.db);
+        text.get(span.start as usize..span.end as usize)
+            .unwrap_or_default()
+    }
+}
+
+pub fn shift(s: Span, offset: u32) -> Span {
+    Span {
+        start: s.start + offset,
+        end: s.end + offset,
+        ..s
+    }
+}

@@ -1,0 +1,174 @@
+//! Formatting and code actions: quick fixes from diagnostics, and rule
+//! stubs for the domain actions no rule covers.
+
+use crate::analysis::Analysis;
+use crate::convert::LineIndex;
+use btc_lang::db::{import_closure, parsed_rules, rules_diagnostics};
+use btc_lang::diagnostic::Diagnostic;
+use btc_lang::pddl::ast::{Action, TypeSpec};
+use btc_lang::rules::ast::Item;
+use btc_lang::rules::matching::match_name;
+use std::collections::HashMap;
+use tower_lsp::lsp_types::{
+    CodeAction, CodeActionKind, Position, Range, TextEdit, Url, WorkspaceEdit,
+};
+
+/// The whole document formatted, as one edit; `None` when the text does
+/// not parse (the formatter refuses it) or is formatted already.
+pub fn format(a: &Analysis) -> Option<Vec<TextEdit>> {
+    let formatted = btc_lang::rules::fmt::format(a.text).ok()?;
+    if formatted == a.text {
+        return Some(Vec::new());
+    }
+    let ix = a.line_index();
+    Some(vec![TextEdit::new(
+        Range::new(Position::new(0, 0), ix.position(a.text.len())),
+        formatted,
+    )])
+}
+
+fn edit(uri: &Url, edits: Vec<TextEdit>) -> WorkspaceEdit {
+    WorkspaceEdit::new(HashMap::from([(uri.clone(), edits)]))
+}
+
+/// Code actions for a range of the document: each diagnostic fix there,
+/// and "add rule stubs" when domain actions lack rules.
+pub fn code_actions(
+    a: &Analysis,
+    uri: &Url,
+    range: Range,
+    to_lsp: &dyn Fn(&Diagnostic) -> tower_lsp::lsp_types::Diagnostic,
+) -> Vec<CodeAction> {
+    let ix = a.line_index();
+    let (from, to) = (ix.offset(range.start) as u32, ix.offset(range.end) as u32);
+    let mut out = Vec::new();
+    let file_id = btc_lang::db::file_id(&a.ws.db, a.file);
+    for d in rules_diagnostics(&a.ws.db, a.file) {
+        if d.span.file != file_id || d.span.end < from || d.span.start > to {
+            continue;
+        }
+        for f in d.fixes.iter().filter(|f| f.span.file == file_id) {
+            out.push(CodeAction {
+                title: f.title.clone(),
+                kind: Some(CodeActionKind::QUICKFIX),
+                diagnostics: Some(vec![to_lsp(d)]),
+                edit: Some(edit(uri, vec![TextEdit::new(ix.range(f.span), f.replacement.clone())])),
+                is_preferred: Some(d.fixes.len() == 1),
+                ..CodeAction::default()
+            });
+        }
+    }
+    if let Some(text) = rule_stubs(a) {
+        let uncovered = text.matches("\nrule (").count();
+        out.push(CodeAction {
+            title: format!(
+                "Add rule stubs for {uncovered} uncovered domain action{}",
+                if uncovered == 1 { "" } else { "s" }
+            ),
+            kind: Some(CodeActionKind::QUICKFIX),
+            edit: Some(edit(
+                uri,
+                vec![TextEdit::new(
+                    Range::new(ix.position(a.text.len()), ix.position(a.text.len())),
+                    text,
+                )],
+            )),
+            ..CodeAction::default()
+        });
+    }
+    out
+}
+
+/// `pick-up` / `PICK_UP` -> `PickUp`.
+fn camel(name: &str) -> String {
+    name.split(['-', '_'])
+        .filter(|w| !w.is_empty())
+        .map(|w| {
+            let mut c = w.chars();
+            c.next()
+                .map(|f| f.to_uppercase().chain(c.flat_map(char::to_lowercase)).collect::<String>())
+                .unwrap_or_default()
+        })
+        .collect()
+}
+
+fn port_name(var: &str) -> String {
+    var.replace('-', "_")
+}
+
+fn port_type(t: &TypeSpec) -> String {
+    match t {
+        TypeSpec::Named { name } => name.name.clone(),
+        TypeSpec::Object | TypeSpec::Either { .. } => "object".into(),
+    }
+}
+
+/// Text to append to the file: for each domain action no rule in scope
+/// covers, a leaf declaration (unless one of that name exists) and a rule
+/// that calls it, with parameters named as in the domain.
+pub fn rule_stubs(a: &Analysis) -> Option<String> {
+    let (_, domain, _) = a.domain?;
+    let mut patterns = Vec::new();
+    for f in import_closure(&a.ws.db, a.file).0.iter() {
+        for n in &parsed_rules(&a.ws.db, *f).items {
+            if let Item::Rule(r) = &n.item {
+                patterns.push(&r.pattern.name);
+            }
+        }
+    }
+    let uncovered: Vec<&Action> = domain
+        .actions
+        .iter()
+        .filter(|act| !patterns.iter().any(|p| match_name(p, &act.name.name).is_some()))
+        .collect();
+    if uncovered.is_empty() {
+        return None;
+    }
+    let mut text = String::new();
+    if !a.text.ends_with('\n') && !a.text.is_empty() {
+        text.push('\n');
+    }
+    for act in uncovered {
+        let node = camel(&act.name.name);
+        text.push('\n');
+        if !a.decls.nodes.contains_key(&node) && !a.decls.trees.contains_key(&node) {
+            let ports: Vec<String> = act
+                .params
+                .iter()
+                .map(|p| format!("{}: {}", port_name(&p.name.name), port_type(&p.ty)))
+                .collect();
+            text.push_str(&format!("action {node}({})\n", ports.join(", ")));
+        }
+        let vars: Vec<String> = act.params.iter().map(|p| format!("?{}", p.name.name)).collect();
+        let args: Vec<String> = act
+            .params
+            .iter()
+            .map(|p| format!("{}: ?{}", port_name(&p.name.name), p.name.name))
+            .collect();
+        let head = if vars.is_empty() {
+            act.name.name.clone()
+        } else {
+            format!("{} {}", act.name.name, vars.join(" "))
+        };
+        text.push_str(&format!(
+            "rule ({head}) {{\n    {node}({})\n}}\n",
+            args.join(", ")
+        ));
+    }
+    Some(text)
+}
+
+/// Where an edit lands, for tests: the text with the edits applied.
+pub fn apply(text: &str, edits: &[TextEdit]) -> String {
+    let ix = LineIndex::new(text);
+    let mut spans: Vec<(usize, usize, &str)> = edits
+        .iter()
+        .map(|e| (ix.offset(e.range.start), ix.offset(e.range.end), e.new_text.as_str()))
+        .collect();
+    spans.sort_by_key(|s| std::cmp::Reverse(s.0));
+    let mut out = text.to_owned();
+    for (a, b, t) in spans {
+        out.replace_range(a..b, t);
+    }
+    out
+}

@@ -1,0 +1,349 @@
+//! The tower-lsp shell: requests in, library calls, responses out. The
+//! workspace sits behind a std mutex that is never held across an
+//! `.await`: every request computes under the lock, then answers.
+
+use crate::analysis::Analysis;
+use crate::convert::LineIndex;
+use crate::workspace::{FileDiagnostics, Workspace};
+use crate::{completion, edits, highlight, navigation, symbols};
+use btc_lang::diagnostic::{Diagnostic, Severity};
+use std::sync::{Arc, Mutex, MutexGuard};
+use tower_lsp::jsonrpc::{Error, Result};
+use tower_lsp::lsp_types::*;
+use tower_lsp::{Client, LanguageServer};
+
+pub struct Backend {
+    client: Client,
+    ws: Arc<Mutex<Workspace>>,
+}
+
+impl Backend {
+    pub fn new(client: Client) -> Backend {
+        Backend {
+            client,
+            ws: Arc::new(Mutex::new(Workspace::new())),
+        }
+    }
+
+    fn ws(&self) -> MutexGuard<'_, Workspace> {
+        // A panic while holding the lock poisons it; the workspace is still
+        // consistent (salsa inputs are set atomically), so keep serving.
+        self.ws.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Re-checks and publishes diagnostics for every affected file.
+    async fn publish(&self) {
+        let batches: Vec<(Url, Vec<tower_lsp::lsp_types::Diagnostic>, Option<i32>)> = {
+            let mut ws = self.ws();
+            let all = ws.diagnostics();
+            all.into_iter()
+                .filter_map(|fd| convert_file(&ws, fd))
+                .collect()
+        };
+        for (uri, diags, version) in batches {
+            self.client.publish_diagnostics(uri, diags, version).await;
+        }
+    }
+
+    /// Runs `f` on the analysis of the document `uri`, if it is a rules file.
+    fn with_analysis<T>(&self, uri: &Url, f: impl FnOnce(&Analysis) -> Option<T>) -> Option<T> {
+        let path = path_of(uri)?;
+        let ws = self.ws();
+        let a = Analysis::new(&ws, &path)?;
+        f(&a)
+    }
+}
+
+/// The database path of a document URI (an absolute file path).
+pub fn path_of(uri: &Url) -> Option<String> {
+    let p = uri.to_file_path().ok()?;
+    Some(btc_lang::db::normalize(&p))
+}
+
+fn convert_file(
+    ws: &Workspace,
+    fd: FileDiagnostics,
+) -> Option<(Url, Vec<tower_lsp::lsp_types::Diagnostic>, Option<i32>)> {
+    let uri = Url::from_file_path(&fd.path).ok()?;
+    let text = ws.text(&fd.path).unwrap_or_default();
+    let ix = LineIndex::new(text);
+    let diags = fd
+        .diagnostics
+        .iter()
+        .map(|d| to_lsp(ws, &ix, d))
+        .collect();
+    Some((uri, diags, fd.version))
+}
+
+/// A btc diagnostic as LSP sees it: range, code, message with its hint,
+/// secondary labels as related information.
+pub fn to_lsp(ws: &Workspace, ix: &LineIndex, d: &Diagnostic) -> tower_lsp::lsp_types::Diagnostic {
+    let mut message = d.message.clone();
+    if let Some(h) = &d.hint {
+        message.push_str("\nhint: ");
+        message.push_str(h);
+    }
+    let related: Vec<DiagnosticRelatedInformation> = d
+        .labels
+        .iter()
+        .filter_map(|l| {
+            let path = ws.path_of(l.span.file)?;
+            let uri = Url::from_file_path(&path).ok()?;
+            let text = ws.text(&path)?;
+            Some(DiagnosticRelatedInformation {
+                location: Location::new(uri, LineIndex::new(text).range(l.span)),
+                message: l.message.clone(),
+            })
+        })
+        .collect();
+    tower_lsp::lsp_types::Diagnostic {
+        range: ix.range(d.span),
+        severity: Some(match d.severity {
+            Severity::Error => DiagnosticSeverity::ERROR,
+            Severity::Warning => DiagnosticSeverity::WARNING,
+        }),
+        code: Some(NumberOrString::String(d.code.to_owned())),
+        source: Some("btc".into()),
+        message,
+        related_information: (!related.is_empty()).then_some(related),
+        ..tower_lsp::lsp_types::Diagnostic::default()
+    }
+}
+
+pub fn capabilities() -> ServerCapabilities {
+    ServerCapabilities {
+        text_document_sync: Some(TextDocumentSyncCapability::Options(
+            TextDocumentSyncOptions {
+                open_close: Some(true),
+                change: Some(TextDocumentSyncKind::INCREMENTAL),
+                save: Some(TextDocumentSyncSaveOptions::Supported(true)),
+                ..TextDocumentSyncOptions::default()
+            },
+        )),
+        hover_provider: Some(HoverProviderCapability::Simple(true)),
+        definition_provider: Some(OneOf::Left(true)),
+        references_provider: Some(OneOf::Left(true)),
+        document_symbol_provider: Some(OneOf::Left(true)),
+        workspace_symbol_provider: Some(OneOf::Left(true)),
+        completion_provider: Some(CompletionOptions {
+            trigger_characters: Some(vec!["?".into(), "(".into(), ":".into(), "[".into()]),
+            ..CompletionOptions::default()
+        }),
+        signature_help_provider: Some(SignatureHelpOptions {
+            trigger_characters: Some(vec!["(".into(), ",".into()]),
+            retrigger_characters: None,
+            work_done_progress_options: WorkDoneProgressOptions::default(),
+        }),
+        semantic_tokens_provider: Some(SemanticTokensServerCapabilities::SemanticTokensOptions(
+            SemanticTokensOptions {
+                legend: highlight::legend(),
+                full: Some(SemanticTokensFullOptions::Bool(true)),
+                range: None,
+                work_done_progress_options: WorkDoneProgressOptions::default(),
+            },
+        )),
+        document_formatting_provider: Some(OneOf::Left(true)),
+        rename_provider: Some(OneOf::Left(true)),
+        inlay_hint_provider: Some(OneOf::Left(true)),
+        code_action_provider: Some(CodeActionProviderCapability::Options(CodeActionOptions {
+            code_action_kinds: Some(vec![CodeActionKind::QUICKFIX]),
+            ..CodeActionOptions::default()
+        })),
+        ..ServerCapabilities::default()
+    }
+}
+
+#[tower_lsp::async_trait]
+impl LanguageServer for Backend {
+    async fn initialize(&self, _: InitializeParams) -> Result<InitializeResult> {
+        Ok(InitializeResult {
+            capabilities: capabilities(),
+            server_info: Some(ServerInfo {
+                name: "btc".into(),
+                version: Some(env!("CARGO_PKG_VERSION").into()),
+            }),
+        })
+    }
+
+    async fn initialized(&self, _: InitializedParams) {
+        // Watch PDDL and rules files on disk, so that a domain edited
+        // outside the editor re-checks the rules that use it. Clients that
+        // cannot register dynamically answer with an error: nothing lost.
+        let watchers = ["**/*.pddl", "**/*.btrules"]
+            .iter()
+            .map(|g| FileSystemWatcher {
+                glob_pattern: GlobPattern::String((*g).into()),
+                kind: None,
+            })
+            .collect();
+        let reg = Registration {
+            id: "btc-watch".into(),
+            method: "workspace/didChangeWatchedFiles".into(),
+            register_options: serde_json::to_value(DidChangeWatchedFilesRegistrationOptions {
+                watchers,
+            })
+            .ok(),
+        };
+        let _ = self.client.register_capability(vec![reg]).await;
+    }
+
+    async fn shutdown(&self) -> Result<()> {
+        Ok(())
+    }
+
+    async fn did_open(&self, p: DidOpenTextDocumentParams) {
+        if let Some(path) = path_of(&p.text_document.uri) {
+            self.ws()
+                .open(&path, p.text_document.text, p.text_document.version);
+        }
+        self.publish().await;
+    }
+
+    async fn did_change(&self, p: DidChangeTextDocumentParams) {
+        if let Some(path) = path_of(&p.text_document.uri) {
+            self.ws()
+                .change(&path, p.content_changes, p.text_document.version);
+        }
+        self.publish().await;
+    }
+
+    async fn did_save(&self, _: DidSaveTextDocumentParams) {}
+
+    async fn did_close(&self, p: DidCloseTextDocumentParams) {
+        if let Some(path) = path_of(&p.text_document.uri) {
+            self.ws().close(&path);
+        }
+        self.publish().await;
+    }
+
+    async fn did_change_watched_files(&self, p: DidChangeWatchedFilesParams) {
+        {
+            let mut ws = self.ws();
+            for c in p.changes {
+                if let Some(path) = path_of(&c.uri) {
+                    ws.changed_on_disk(&path);
+                }
+            }
+        }
+        self.publish().await;
+    }
+
+    async fn hover(&self, p: HoverParams) -> Result<Option<Hover>> {
+        let pp = p.text_document_position_params;
+        Ok(self.with_analysis(&pp.text_document.uri, |a| {
+            let off = a.line_index().offset(pp.position);
+            navigation::hover(a, off)
+        }))
+    }
+
+    async fn goto_definition(
+        &self,
+        p: GotoDefinitionParams,
+    ) -> Result<Option<GotoDefinitionResponse>> {
+        let pp = p.text_document_position_params;
+        Ok(self.with_analysis(&pp.text_document.uri, |a| {
+            let off = a.line_index().offset(pp.position);
+            let place = navigation::definition(a, off)?;
+            a.location(&place).map(GotoDefinitionResponse::Scalar)
+        }))
+    }
+
+    async fn references(&self, p: ReferenceParams) -> Result<Option<Vec<Location>>> {
+        let pp = p.text_document_position;
+        let include = p.context.include_declaration;
+        Ok(self.with_analysis(&pp.text_document.uri, |a| {
+            let off = a.line_index().offset(pp.position);
+            let def = navigation::definition(a, off);
+            let places = navigation::references(a, off)?;
+            Some(
+                places
+                    .iter()
+                    .filter(|pl| include || Some(*pl) != def.as_ref())
+                    .filter_map(|pl| a.location(pl))
+                    .collect(),
+            )
+        }))
+    }
+
+    async fn document_symbol(
+        &self,
+        p: DocumentSymbolParams,
+    ) -> Result<Option<DocumentSymbolResponse>> {
+        Ok(self.with_analysis(&p.text_document.uri, |a| {
+            Some(DocumentSymbolResponse::Nested(symbols::document_symbols(a)))
+        }))
+    }
+
+    async fn symbol(
+        &self,
+        p: WorkspaceSymbolParams,
+    ) -> Result<Option<Vec<SymbolInformation>>> {
+        let ws = self.ws();
+        Ok(Some(symbols::workspace_symbols(&ws, &p.query)))
+    }
+
+    async fn completion(&self, p: CompletionParams) -> Result<Option<CompletionResponse>> {
+        let pp = p.text_document_position;
+        Ok(self.with_analysis(&pp.text_document.uri, |a| {
+            let off = a.line_index().offset(pp.position);
+            Some(CompletionResponse::Array(completion::completion(a, off)))
+        }))
+    }
+
+    async fn signature_help(&self, p: SignatureHelpParams) -> Result<Option<SignatureHelp>> {
+        let pp = p.text_document_position_params;
+        Ok(self.with_analysis(&pp.text_document.uri, |a| {
+            let off = a.line_index().offset(pp.position);
+            completion::signature_help(a, off)
+        }))
+    }
+
+    async fn semantic_tokens_full(
+        &self,
+        p: SemanticTokensParams,
+    ) -> Result<Option<SemanticTokensResult>> {
+        Ok(self.with_analysis(&p.text_document.uri, |a| {
+            Some(SemanticTokensResult::Tokens(SemanticTokens {
+                result_id: None,
+                data: highlight::semantic_tokens(a),
+            }))
+        }))
+    }
+
+    async fn formatting(&self, p: DocumentFormattingParams) -> Result<Option<Vec<TextEdit>>> {
+        Ok(self.with_analysis(&p.text_document.uri, edits::format))
+    }
+
+    async fn rename(&self, p: RenameParams) -> Result<Option<WorkspaceEdit>> {
+        let pp = p.text_document_position;
+        let r = self.with_analysis(&pp.text_document.uri, |a| {
+            let off = a.line_index().offset(pp.position);
+            Some(navigation::rename(a, off, &p.new_name))
+        });
+        match r {
+            None => Ok(None),
+            Some(Ok(edit)) => Ok(Some(edit)),
+            Some(Err(e)) => Err(Error::invalid_params(e.0)),
+        }
+    }
+
+    async fn inlay_hint(&self, p: InlayHintParams) -> Result<Option<Vec<InlayHint>>> {
+        Ok(self.with_analysis(&p.text_document.uri, |a| {
+            Some(highlight::inlay_hints(a, p.range))
+        }))
+    }
+
+    async fn code_action(&self, p: CodeActionParams) -> Result<Option<CodeActionResponse>> {
+        let uri = p.text_document.uri.clone();
+        Ok(self.with_analysis(&p.text_document.uri, |a| {
+            let ix = a.line_index();
+            let conv = |d: &Diagnostic| to_lsp(a.ws, &ix, d);
+            Some(
+                edits::code_actions(a, &uri, p.range, &conv)
+                    .into_iter()
+                    .map(CodeActionOrCommand::CodeAction)
+                    .collect(),
+            )
+        }))
+    }
+}
