@@ -131,10 +131,11 @@ pub fn context(a: &Analysis, offset: usize) -> Context {
             Context::Template
         };
     }
-    let at_line_start = before
-        .rsplit('\n')
-        .next()
-        .is_some_and(|line| line.trim_start().chars().all(|ch| ch.is_alphanumeric() || ch == '_'));
+    let at_line_start = before.rsplit('\n').next().is_some_and(|line| {
+        line.trim_start()
+            .chars()
+            .all(|ch| ch.is_alphanumeric() || ch == '_')
+    });
     if at_line_start && depth == 0 {
         Context::TopLevel
     } else {
@@ -142,7 +143,11 @@ pub fn context(a: &Analysis, offset: usize) -> Context {
     }
 }
 
-fn item(label: impl Into<String>, kind: CompletionItemKind, detail: Option<String>) -> CompletionItem {
+fn item(
+    label: impl Into<String>,
+    kind: CompletionItemKind,
+    detail: Option<String>,
+) -> CompletionItem {
     CompletionItem {
         label: label.into(),
         kind: Some(kind),
@@ -156,7 +161,12 @@ fn signature(name: &str, ports: &[PortDecl]) -> String {
         "{name}({})",
         ports
             .iter()
-            .map(|p| format!("{}{}: {}", if p.out { "out " } else { "" }, p.name.text, p.ty.text))
+            .map(|p| format!(
+                "{}{}: {}",
+                if p.out { "out " } else { "" },
+                p.name.text,
+                p.ty.text
+            ))
             .collect::<Vec<_>>()
             .join(", ")
     )
@@ -204,7 +214,12 @@ fn variables(a: &Analysis, offset: usize) -> Vec<CompletionItem> {
                     Tok::Var(v) if !v.is_empty() => Some(format!("?{v}")),
                     _ => None,
                 })
-                .collect::<std::collections::BTreeSet<_>>()
+                .fold(Vec::new(), |mut seen, v| {
+                    if !seen.contains(&v) {
+                        seen.push(v);
+                    }
+                    seen
+                })
                 .into_iter()
                 .map(|v| item(v, CompletionItemKind::VARIABLE, None))
                 .collect()
@@ -229,8 +244,11 @@ pub fn completion(a: &Analysis, offset: usize) -> Vec<CompletionItem> {
         Context::Predicate => {
             if let Some((_, d, _)) = a.domain {
                 for p in &d.predicates {
-                    let params: Vec<String> =
-                        p.params.iter().map(|t| format!("?{} - {}", t.name.name, t.ty)).collect();
+                    let params: Vec<String> = p
+                        .params
+                        .iter()
+                        .map(|t| format!("?{} - {}", t.name.name, t.ty))
+                        .collect();
                     out.push(item(
                         p.name.name.clone(),
                         CompletionItemKind::FUNCTION,
@@ -245,8 +263,11 @@ pub fn completion(a: &Analysis, offset: usize) -> Vec<CompletionItem> {
         Context::RuleHead => {
             if let Some((_, d, _)) = a.domain {
                 for act in &d.actions {
-                    let params: Vec<String> =
-                        act.params.iter().map(|p| format!("?{}", p.name.name)).collect();
+                    let params: Vec<String> = act
+                        .params
+                        .iter()
+                        .map(|p| format!("?{}", p.name.name))
+                        .collect();
                     let mut c = item(
                         act.name.name.clone(),
                         CompletionItemKind::METHOD,
@@ -265,7 +286,11 @@ pub fn completion(a: &Analysis, offset: usize) -> Vec<CompletionItem> {
         Context::TableKey(table) => {
             if let Some(t) = a.decls.tables.get(&table) {
                 for e in &t.entries {
-                    out.push(item(e.key.text.clone(), CompletionItemKind::ENUM_MEMBER, None));
+                    out.push(item(
+                        e.key.text.clone(),
+                        CompletionItemKind::ENUM_MEMBER,
+                        None,
+                    ));
                 }
             }
         }
@@ -295,7 +320,11 @@ pub fn completion(a: &Analysis, offset: usize) -> Vec<CompletionItem> {
         Context::PortValue => {
             out = variables(a, offset);
             for name in a.decls.tables.keys() {
-                out.push(item(name.clone(), CompletionItemKind::ENUM, Some("table".into())));
+                out.push(item(
+                    name.clone(),
+                    CompletionItemKind::ENUM,
+                    Some("table".into()),
+                ));
             }
         }
         Context::Template => {
@@ -354,7 +383,12 @@ pub fn signature_help(a: &Analysis, offset: usize) -> Option<SignatureHelp> {
     let mut params = Vec::new();
     let mut pos = node.encode_utf16().count() + 1;
     for (i, p) in ports.iter().enumerate() {
-        let text = format!("{}{}: {}", if p.out { "out " } else { "" }, p.name.text, p.ty.text);
+        let text = format!(
+            "{}{}: {}",
+            if p.out { "out " } else { "" },
+            p.name.text,
+            p.ty.text
+        );
         let len = text.encode_utf16().count();
         params.push(ParameterInformation {
             label: ParameterLabel::LabelOffsets([pos as u32, (pos + len) as u32]),

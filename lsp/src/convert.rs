@@ -52,20 +52,20 @@ impl<'a> LineIndex<'a> {
         let Some(&start) = self.starts.get(p.line as usize) else {
             return self.text.len();
         };
-        let end = self
+        let mut end = self
             .starts
             .get(p.line as usize + 1)
             .map_or(self.text.len(), |&next| next - 1);
+        // A line's end is before its `\r\n`.
+        if self.text[start..end].ends_with('\r') {
+            end -= 1;
+        }
         let mut units = 0usize;
         for (i, c) in self.text[start..end].char_indices() {
             if units + c.len_utf16() > p.character as usize {
                 return start + i;
             }
             units += c.len_utf16();
-        }
-        // The line's end, before a `\r\n`'s `\r` too.
-        if self.text[start..end].ends_with('\r') && units >= p.character as usize {
-            return end - 1;
         }
         end
     }

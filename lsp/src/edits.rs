@@ -52,7 +52,10 @@ pub fn code_actions(
                 title: f.title.clone(),
                 kind: Some(CodeActionKind::QUICKFIX),
                 diagnostics: Some(vec![to_lsp(d)]),
-                edit: Some(edit(uri, vec![TextEdit::new(ix.range(f.span), f.replacement.clone())])),
+                edit: Some(edit(
+                    uri,
+                    vec![TextEdit::new(ix.range(f.span), f.replacement.clone())],
+                )),
                 is_preferred: Some(d.fixes.len() == 1),
                 ..CodeAction::default()
             });
@@ -86,7 +89,11 @@ fn camel(name: &str) -> String {
         .map(|w| {
             let mut c = w.chars();
             c.next()
-                .map(|f| f.to_uppercase().chain(c.flat_map(char::to_lowercase)).collect::<String>())
+                .map(|f| {
+                    f.to_uppercase()
+                        .chain(c.flat_map(char::to_lowercase))
+                        .collect::<String>()
+                })
                 .unwrap_or_default()
         })
         .collect()
@@ -119,7 +126,11 @@ pub fn rule_stubs(a: &Analysis) -> Option<String> {
     let uncovered: Vec<&Action> = domain
         .actions
         .iter()
-        .filter(|act| !patterns.iter().any(|p| match_name(p, &act.name.name).is_some()))
+        .filter(|act| {
+            !patterns
+                .iter()
+                .any(|p| match_name(p, &act.name.name).is_some())
+        })
         .collect();
     if uncovered.is_empty() {
         return None;
@@ -139,7 +150,11 @@ pub fn rule_stubs(a: &Analysis) -> Option<String> {
                 .collect();
             text.push_str(&format!("action {node}({})\n", ports.join(", ")));
         }
-        let vars: Vec<String> = act.params.iter().map(|p| format!("?{}", p.name.name)).collect();
+        let vars: Vec<String> = act
+            .params
+            .iter()
+            .map(|p| format!("?{}", p.name.name))
+            .collect();
         let args: Vec<String> = act
             .params
             .iter()
@@ -163,7 +178,13 @@ pub fn apply(text: &str, edits: &[TextEdit]) -> String {
     let ix = LineIndex::new(text);
     let mut spans: Vec<(usize, usize, &str)> = edits
         .iter()
-        .map(|e| (ix.offset(e.range.start), ix.offset(e.range.end), e.new_text.as_str()))
+        .map(|e| {
+            (
+                ix.offset(e.range.start),
+                ix.offset(e.range.end),
+                e.new_text.as_str(),
+            )
+        })
         .collect();
     spans.sort_by_key(|s| std::cmp::Reverse(s.0));
     let mut out = text.to_owned();

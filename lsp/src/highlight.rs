@@ -76,7 +76,10 @@ pub fn semantic_tokens(a: &Analysis) -> Vec<SemanticToken> {
     let mut out = Vec::new();
     let (mut last_line, mut last_col) = (0u32, 0u32);
     for (span, ty) in classified(a) {
-        let piece_text = a.text.get(span.start as usize..span.end as usize).unwrap_or_default();
+        let piece_text = a
+            .text
+            .get(span.start as usize..span.end as usize)
+            .unwrap_or_default();
         let mut start = span.start as usize;
         for line in piece_text.split_inclusive('\n') {
             let content = line.trim_end_matches(['\n', '\r']);
@@ -84,7 +87,11 @@ pub fn semantic_tokens(a: &Analysis) -> Vec<SemanticToken> {
             if len > 0 {
                 let p = ix.position(start);
                 let delta_line = p.line - last_line;
-                let delta_start = if delta_line == 0 { p.character - last_col } else { p.character };
+                let delta_start = if delta_line == 0 {
+                    p.character - last_col
+                } else {
+                    p.character
+                };
                 out.push(SemanticToken {
                     delta_line,
                     delta_start,

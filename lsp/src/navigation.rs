@@ -22,7 +22,10 @@ pub fn hover(a: &Analysis, offset: usize) -> Option<Hover> {
             let r = a.rule(*item)?;
             let actions = a.actions_of(r);
             if actions.is_empty() {
-                format!("`{}`: no action of the domain matches", r.pattern.name_text())
+                format!(
+                    "`{}`: no action of the domain matches",
+                    r.pattern.name_text()
+                )
             } else {
                 let (dfile, _, _) = a.domain?;
                 actions
@@ -52,7 +55,10 @@ pub fn hover(a: &Analysis, offset: usize) -> Option<Hover> {
                 }
             }
             Item::Tree(t) => match t.ports.iter().find(|p| p.name.text == *name) {
-                Some(p) => format!("`?{name}`: `{}` (a port of tree `{}`)", p.ty.text, t.name.text),
+                Some(p) => format!(
+                    "`?{name}`: `{}` (a port of tree `{}`)",
+                    p.ty.text, t.name.text
+                ),
                 None => format!("`?{name}` is not a port of tree `{}`", t.name.text),
             },
             _ => format!("`?{name}`"),
@@ -86,12 +92,20 @@ pub fn hover(a: &Analysis, offset: usize) -> Option<Hover> {
                         .ports
                         .iter()
                         .map(|p| {
-                            format!("{}{}: {}", if p.out { "out " } else { "" }, p.name.text, p.ty.text)
+                            format!(
+                                "{}{}: {}",
+                                if p.out { "out " } else { "" },
+                                p.name.text,
+                                p.ty.text
+                            )
                         })
                         .collect();
                     let mut s = format!("{kind} {}({})", n.name.text, ports.join(", "));
                     if let Some(f) = &n.formula {
-                        let src = a.source_of(place.file, shift(f.span(), place.span.start - n.name.span.start));
+                        let src = a.source_of(
+                            place.file,
+                            shift(f.span(), place.span.start - n.name.span.start),
+                        );
                         s.push_str(&format!(" = {src}"));
                     }
                     s
@@ -107,7 +121,11 @@ pub fn hover(a: &Analysis, offset: usize) -> Option<Hover> {
                 _ => return None,
             };
             let origin = place.file.path(&a.ws.db);
-            format!("{}\n\ndeclared in `{}`", code_block("btrules", &decl), short(origin))
+            format!(
+                "{}\n\ndeclared in `{}`",
+                code_block("btrules", &decl),
+                short(origin)
+            )
         }
         Symbol::Table { name, .. } => {
             let (place, _) = a.declaration(name, true)?;
@@ -119,10 +137,17 @@ pub fn hover(a: &Analysis, offset: usize) -> Option<Hover> {
                 .iter()
                 .map(|e| {
                     let off = place.span.start - t.name.span.start;
-                    format!("{}: {}", e.key.text, a.source_of(place.file, shift(e.value.span(), off)))
+                    format!(
+                        "{}: {}",
+                        e.key.text,
+                        a.source_of(place.file, shift(e.value.span(), off))
+                    )
                 })
                 .collect();
-            code_block("btrules", &format!("table {} {{ {} }}", t.name.text, entries.join(", ")))
+            code_block(
+                "btrules",
+                &format!("table {} {{ {} }}", t.name.text, entries.join(", ")),
+            )
         }
         Symbol::Port { node, port, .. } => {
             let ports = a.decls.ports(node)?;
@@ -153,7 +178,14 @@ pub fn hover(a: &Analysis, offset: usize) -> Option<Hover> {
                     if parents.is_empty() {
                         format!("PDDL type `{lower}`")
                     } else {
-                        format!("PDDL type `{lower}`, a kind of {}", parents.iter().map(|p| format!("`{p}`")).collect::<Vec<_>>().join(", "))
+                        format!(
+                            "PDDL type `{lower}`, a kind of {}",
+                            parents
+                                .iter()
+                                .map(|p| format!("`{p}`"))
+                                .collect::<Vec<_>>()
+                                .join(", ")
+                        )
                     }
                 }
                 None => format!("`{name}`: a basic type"),
@@ -198,7 +230,14 @@ pub fn definition(a: &Analysis, offset: usize) -> Option<Place> {
         Symbol::Var { item, name } => {
             let n = &a.items[item];
             let span = match &n.item {
-                Item::Rule(r) => r.pattern.params.iter().find(|p| p.var.text == name)?.var.span,
+                Item::Rule(r) => {
+                    r.pattern
+                        .params
+                        .iter()
+                        .find(|p| p.var.text == name)?
+                        .var
+                        .span
+                }
                 Item::Tree(t) => t.ports.iter().find(|p| p.name.text == name)?.name.span,
                 _ => return None,
             };
@@ -211,7 +250,9 @@ pub fn definition(a: &Analysis, offset: usize) -> Option<Place> {
             let n = &a.items[item];
             let r = a.rule(item)?;
             let span = r.pattern.name.iter().find_map(|p| match p {
-                btc_lang::rules::ast::NamePart::Capture { name: c } if c.text == name => Some(c.span),
+                btc_lang::rules::ast::NamePart::Capture { name: c } if c.text == name => {
+                    Some(c.span)
+                }
                 _ => None,
             })?;
             Some(Place {
@@ -272,7 +313,10 @@ pub fn references(a: &Analysis, offset: usize) -> Option<Vec<Place>> {
         Symbol::Var { item, name } | Symbol::Capture { item, name } => {
             let var = matches!(sym, Symbol::Var { .. });
             let n = &a.items[*item];
-            let end = a.items.get(item + 1).map_or(a.text.len() as u32, |m| m.offset);
+            let end = a
+                .items
+                .get(item + 1)
+                .map_or(a.text.len() as u32, |m| m.offset);
             for (i, (_, s)) in a.syntax.tokens.toks.iter().enumerate() {
                 if s.start < n.offset || s.end > end {
                     continue;
@@ -287,14 +331,22 @@ pub fn references(a: &Analysis, offset: usize) -> Option<Vec<Place>> {
                     && matches!(&a.syntax.tokens.toks[i].0, btc_lang::rules::lexer::Tok::Ident(t) if t == name)
                     && !a.syntax.tokens.in_pddl(i);
                 if same || bare {
-                    out.push(Place { file: a.file, span: *s });
+                    out.push(Place {
+                        file: a.file,
+                        span: *s,
+                    });
                 }
             }
             for s in a.syntax.interpolations(*item, name, var) {
-                out.push(Place { file: a.file, span: s });
+                out.push(Place {
+                    file: a.file,
+                    span: s,
+                });
             }
         }
-        Symbol::Node { name, .. } | Symbol::Table { name, .. } | Symbol::Port { port: name, .. } => {
+        Symbol::Node { name, .. }
+        | Symbol::Table { name, .. }
+        | Symbol::Port { port: name, .. } => {
             for f in a.ws.all_rules() {
                 let Some(other) = Analysis::new(a.ws, f.path(&a.ws.db)) else {
                     continue;
@@ -309,7 +361,9 @@ pub fn references(a: &Analysis, offset: usize) -> Option<Vec<Place>> {
                         (Symbol::Table { .. }, Some(Symbol::Table { name: m, .. })) => m == *name,
                         (
                             Symbol::Port { node, .. },
-                            Some(Symbol::Port { node: n2, port: p2, .. }),
+                            Some(Symbol::Port {
+                                node: n2, port: p2, ..
+                            }),
                         ) => n2 == *node && p2 == *name,
                         _ => false,
                     };
@@ -323,7 +377,10 @@ pub fn references(a: &Analysis, offset: usize) -> Option<Vec<Place>> {
             // References of PDDL names within the rules in scope.
             for (i, (_, s)) in a.syntax.tokens.toks.iter().enumerate() {
                 if a.syntax.classify(i).as_ref() == Some(&sym) {
-                    out.push(Place { file: a.file, span: *s });
+                    out.push(Place {
+                        file: a.file,
+                        span: *s,
+                    });
                 }
             }
             if let Some(def) = definition(a, offset) {
@@ -349,7 +406,9 @@ pub fn rename(a: &Analysis, offset: usize, new_name: &str) -> Result<WorkspaceEd
     };
     let bare = new_name.trim_start_matches('?');
     let valid = bare.starts_with(|c: char| c.is_alphabetic() || c == '_')
-        && bare.chars().all(|c| c.is_alphanumeric() || c == '_' || c == '-');
+        && bare
+            .chars()
+            .all(|c| c.is_alphanumeric() || c == '_' || c == '-');
     if !valid {
         return Err(RenameError(format!("`{new_name}` is not a valid name")));
     }
@@ -369,10 +428,15 @@ pub fn rename(a: &Analysis, offset: usize, new_name: &str) -> Result<WorkspaceEd
     for p in places {
         // Interpolations (`{?x}`) cover the name without braces.
         let Some(loc) = a.location(&p) else {
-            return Err(RenameError("the name is declared in the stdlib, which cannot be edited".into()));
+            return Err(RenameError(
+                "the name is declared in the stdlib, which cannot be edited".into(),
+            ));
         };
         let Location { uri, range } = loc;
-        changes.entry(uri).or_default().push(TextEdit::new(range, replacement.clone()));
+        changes
+            .entry(uri)
+            .or_default()
+            .push(TextEdit::new(range, replacement.clone()));
     }
     Ok(WorkspaceEdit::new(changes))
 }

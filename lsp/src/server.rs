@@ -67,11 +67,7 @@ fn convert_file(
     let uri = Url::from_file_path(&fd.path).ok()?;
     let text = ws.text(&fd.path).unwrap_or_default();
     let ix = LineIndex::new(text);
-    let diags = fd
-        .diagnostics
-        .iter()
-        .map(|d| to_lsp(ws, &ix, d))
-        .collect();
+    let diags = fd.diagnostics.iter().map(|d| to_lsp(ws, &ix, d)).collect();
     Some((uri, diags, fd.version))
 }
 
@@ -274,10 +270,7 @@ impl LanguageServer for Backend {
         }))
     }
 
-    async fn symbol(
-        &self,
-        p: WorkspaceSymbolParams,
-    ) -> Result<Option<Vec<SymbolInformation>>> {
+    async fn symbol(&self, p: WorkspaceSymbolParams) -> Result<Option<Vec<SymbolInformation>>> {
         let ws = self.ws();
         Ok(Some(symbols::workspace_symbols(&ws, &p.query)))
     }

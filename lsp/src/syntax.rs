@@ -40,7 +40,15 @@ pub const TEMPLATE_KEYWORDS: &[&str] = &[
 ];
 
 pub const OTHER_KEYWORDS: &[&str] = &[
-    "effect", "where", "in", "skip", "out", "true", "false", "std", "backchained",
+    "effect",
+    "where",
+    "in",
+    "skip",
+    "out",
+    "true",
+    "false",
+    "std",
+    "backchained",
 ];
 
 /// The tokens of a file with absolute spans, and its comments.
@@ -62,21 +70,27 @@ impl Tokens {
     /// cursor just after a name still points at the name).
     pub fn at(&self, offset: usize) -> Option<usize> {
         let o = offset as u32;
-        let i = self.toks.partition_point(|(_, s)| s.end < o);
-        let here = self.toks.get(i).filter(|(_, s)| s.start <= o && o <= s.end)?;
-        // Between `a(`: prefer the name over the punctuation.
-        if matches!(here.0, Tok::Punct(_)) && here.1.start == o && i > 0 {
-            let prev = &self.toks[i - 1];
-            if prev.1.end == o && !matches!(prev.0, Tok::Punct(_)) {
-                return Some(i - 1);
+        // The first token that ends after the cursor: it holds the cursor
+        // if it starts at or before it.
+        let i = self.toks.partition_point(|(_, s)| s.end <= o);
+        let before = i.checked_sub(1).filter(|&j| self.toks[j].1.end == o);
+        match self.toks.get(i) {
+            Some((t, s)) if s.start <= o => {
+                // Between `a(`: prefer the name over the punctuation.
+                let name_before = before.filter(|&j| !matches!(self.toks[j].0, Tok::Punct(_)));
+                match (t, name_before) {
+                    (Tok::Punct(_), Some(j)) if s.start == o => Some(j),
+                    _ => Some(i),
+                }
             }
+            _ => before,
         }
-        Some(i)
     }
 
     /// Index of the first token at or after `offset`.
     pub fn after(&self, offset: usize) -> usize {
-        self.toks.partition_point(|(_, s)| (s.start as usize) < offset)
+        self.toks
+            .partition_point(|(_, s)| (s.start as usize) < offset)
     }
 
     pub fn punct(&self, i: usize) -> Option<&'static str> {
@@ -158,14 +172,28 @@ impl Tokens {
 #[derive(Clone, Debug, PartialEq)]
 pub enum Symbol {
     /// The action name of a rule's pattern.
-    RuleHead { item: usize },
+    RuleHead {
+        item: usize,
+    },
     /// A capture in a rule's pattern name or a `{capture}` use.
-    Capture { item: usize, name: String },
+    Capture {
+        item: usize,
+        name: String,
+    },
     /// `?name` in an item.
-    Var { item: usize, name: String },
+    Var {
+        item: usize,
+        name: String,
+    },
     /// A node or tree, called or declared.
-    Node { name: String, declaration: bool },
-    Table { name: String, declaration: bool },
+    Node {
+        name: String,
+        declaration: bool,
+    },
+    Table {
+        name: String,
+        declaration: bool,
+    },
     /// A port in a call or in a declaration.
     Port {
         node: String,
@@ -173,13 +201,21 @@ pub enum Symbol {
         declaration: bool,
     },
     /// A PDDL predicate in an effect or formula.
-    Predicate { name: String },
+    Predicate {
+        name: String,
+    },
     /// A PDDL type: a port's type or a guard's `?x - type`.
-    Type { name: String },
+    Type {
+        name: String,
+    },
     /// The path string of `domain`, `problem` or `import`.
-    Path { written: String },
+    Path {
+        written: String,
+    },
     /// `std::NAME`.
-    Std { module: String },
+    Std {
+        module: String,
+    },
     Keyword,
 }
 
@@ -253,9 +289,7 @@ impl FileSyntax<'_> {
                         let head = self.abs(ix, r.pattern.name_span());
                         if head.start <= span.start && span.end <= head.end {
                             let capture = r.pattern.name.iter().find_map(|p| match p {
-                                NamePart::Capture { name: c }
-                                    if self.abs(ix, c.span) == *span =>
-                                {
+                                NamePart::Capture { name: c } if self.abs(ix, c.span) == *span => {
                                     Some(c.text.clone())
                                 }
                                 _ => None,
@@ -308,7 +342,10 @@ impl FileSyntax<'_> {
                         return Some(Symbol::Type { name: name.clone() });
                     }
                 }
-                if prev_punct(1) == Some("-") && i >= 2 && matches!(self.tokens.toks[i - 2].0, Tok::Var(_)) {
+                if prev_punct(1) == Some("-")
+                    && i >= 2
+                    && matches!(self.tokens.toks[i - 2].0, Tok::Var(_))
+                {
                     return Some(Symbol::Type { name: name.clone() });
                 }
                 if self.is_node(name) {

@@ -4,9 +4,10 @@
 //! system paths (the stdlib's are `std::NAME`).
 
 use crate::convert::LineIndex;
-use btc_lang::db::{Db as _, 
+use btc_lang::db::{
     checked_domain, checked_problem, declared_path, domain_file, file_id, import_closure,
-    normalize, parsed_rules, problem_file, rules_diagnostics, Database, ProblemOf, SourceFile,
+    normalize, parsed_rules, problem_file, rules_diagnostics, Database, Db as _, ProblemOf,
+    SourceFile,
 };
 use btc_lang::diagnostic::Diagnostic;
 use btc_lang::rules::{ImportTarget, Item};
@@ -73,7 +74,12 @@ impl Workspace {
 
     /// Applies the editor's changes (ranges in UTF-16 positions, applied in
     /// order, each to the text the previous one left).
-    pub fn change(&mut self, path: &str, changes: Vec<TextDocumentContentChangeEvent>, version: i32) {
+    pub fn change(
+        &mut self,
+        path: &str,
+        changes: Vec<TextDocumentContentChangeEvent>,
+        version: i32,
+    ) {
         let mut text = self.text(path).unwrap_or_default().to_owned();
         for c in changes {
             match c.range {
@@ -125,7 +131,10 @@ impl Workspace {
                 continue;
             }
             let Some(f) = self.db.file(&p) else { continue };
-            let dir = Path::new(&p).parent().map(Path::to_path_buf).unwrap_or_default();
+            let dir = Path::new(&p)
+                .parent()
+                .map(Path::to_path_buf)
+                .unwrap_or_default();
             let mut wanted = Vec::new();
             for n in &parsed_rules(&self.db, f).items {
                 match &n.item {
@@ -225,8 +234,8 @@ impl Workspace {
                 }
                 if let Some(p) = problem_file(&self.db, r) {
                     if pddl_seen.insert(p) {
-                        for x in &checked_problem(&self.db, ProblemOf::new(&self.db, p, d))
-                            .diagnostics
+                        for x in
+                            &checked_problem(&self.db, ProblemOf::new(&self.db, p, d)).diagnostics
                         {
                             add(x, &mut by_path);
                         }
@@ -275,9 +284,15 @@ impl Workspace {
     }
 
     /// The domain a rules file names, parsed (when it reads).
-    pub fn domain_of(&self, rules: SourceFile) -> Option<(SourceFile, &btc_lang::pddl::ast::Domain)> {
+    pub fn domain_of(
+        &self,
+        rules: SourceFile,
+    ) -> Option<(SourceFile, &btc_lang::pddl::ast::Domain)> {
         let d = domain_file(&self.db, rules)?;
-        checked_domain(&self.db, d).domain.as_ref().map(|dom| (d, dom))
+        checked_domain(&self.db, d)
+            .domain
+            .as_ref()
+            .map(|dom| (d, dom))
     }
 
     /// Where a rules file's `domain` / `problem` / import string points.
