@@ -27,6 +27,8 @@ pub struct Controller {
     done_rx: Receiver<u64>,
     done: FxHashSet<u64>,
     next: u64,
+    /// Completions received so far.
+    received: u64,
     worker: Option<JoinHandle<Vec<Command>>>,
 }
 
@@ -57,6 +59,7 @@ impl Controller {
             done_rx,
             done: FxHashSet::default(),
             next: 0,
+            received: 0,
             worker,
         }
     }
@@ -69,6 +72,7 @@ impl Controller {
         let sent = self.tx.as_ref().is_some_and(|tx| tx.send(cmd).is_ok());
         if !sent {
             // No consumer: complete it here so no leaf waits forever.
+            self.received += 1;
             self.done.insert(seq);
         }
         seq
@@ -77,6 +81,7 @@ impl Controller {
     /// Collects the completions reported so far.
     pub fn poll(&mut self) {
         while let Ok(seq) = self.done_rx.try_recv() {
+            self.received += 1;
             self.done.insert(seq);
         }
     }
@@ -91,10 +96,25 @@ impl Controller {
         while !self.done.contains(&seq) {
             match self.done_rx.recv() {
                 Ok(s) => {
+                    self.received += 1;
                     self.done.insert(s);
                 }
                 Err(_) => return,
             }
+        }
+    }
+
+    /// Blocks until some completion is at hand (or `timeout` passes), when
+    /// commands are outstanding: the engine then ticks on events, not in a
+    /// busy loop.
+    pub fn wait_any(&mut self, timeout: Duration) {
+        self.poll();
+        if !self.done.is_empty() || self.received == self.next {
+            return;
+        }
+        if let Ok(s) = self.done_rx.recv_timeout(timeout) {
+            self.received += 1;
+            self.done.insert(s);
         }
     }
 

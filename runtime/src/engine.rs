@@ -540,6 +540,9 @@ impl<'w> Engine<'w> {
                 self.finish(Status::Running);
                 return Status::Running;
             }
+            if let Some(c) = self.controller.as_mut() {
+                c.wait_any(std::time::Duration::from_secs(1));
+            }
         }
     }
 
@@ -984,7 +987,8 @@ impl<'w> Engine<'w> {
         let iu = i as usize;
         let started = self.status[iu] == Status::Running && self.cur[iu] != 0;
         if self.faults_live {
-            if let Some(s) = self.faults_on_action(i, a, started) {
+            let fresh = self.status[iu] != Status::Running;
+            if let Some(s) = self.faults_on_action(i, a, fresh) {
                 if s == Status::Failure {
                     self.cur[iu] = 0;
                 }

@@ -441,8 +441,8 @@ impl<'w> Engine<'w> {
     }
 
     /// What faults do to an action leaf: `Some(status)` overrides its tick.
-    pub(crate) fn faults_on_action(&mut self, i: u32, a: u32, started: bool) -> Option<Status> {
-        if !started {
+    pub(crate) fn faults_on_action(&mut self, i: u32, a: u32, fresh: bool) -> Option<Status> {
+        if fresh {
             for f in 0..self.faults.len() {
                 let fire = match &self.faults[f].spec.trigger {
                     Trigger::Action { id, occurrence }
