@@ -27,10 +27,20 @@ pub struct RunArgs {
     pub format: Format,
 }
 
-/// A runtime error as a diagnostic on the file it is about.
-fn diagnostic(e: &LoadError, file: FileId) -> Diagnostic {
-    let at = e.offset.unwrap_or(0);
-    let mut d = Diagnostic::error(e.code, Span::new(file, at, at), e.message.clone());
+/// A runtime error as a diagnostic on the file it is about; the span covers
+/// the word (an XML tag's name) at its offset.
+fn diagnostic(e: &LoadError, file: FileId, sources: &Sources) -> Diagnostic {
+    let text = sources.text(file);
+    let at = e.offset.unwrap_or(0).min(text.len());
+    let end = match e.offset {
+        Some(_) => text[at..]
+            .char_indices()
+            .skip(1)
+            .find(|(_, c)| c.is_whitespace() || matches!(c, '>' | '/' | '='))
+            .map_or(text.len(), |(k, _)| at + k),
+        None => at,
+    };
+    let mut d = Diagnostic::error(e.code, Span::new(file, at, end), e.message.clone());
     if let Some(h) = &e.hint {
         d = d.with_hint(h.clone());
     }
@@ -111,7 +121,7 @@ fn run_tree(a: &RunArgs, tree: &Path) -> anyhow::Result<ExitCode> {
     }
     let (doc, ir) = match btc_runtime::load_tree(sources.text(file)) {
         Ok(x) => x,
-        Err(e) => return fail(&[diagnostic(&e, file)], &sources, a.format),
+        Err(e) => return fail(&[diagnostic(&e, file, &sources)], &sources, a.format),
     };
     // The world: `--problem` (and `--domain`), or the files a JSON IR names.
     let named = |p: Option<&String>| p.map(PathBuf::from).filter(|p| p.is_file());
@@ -163,7 +173,7 @@ fn execute(
     };
     let mut engine = match Engine::build(doc, kb, opts) {
         Ok(e) => e,
-        Err(e) => return fail(&[diagnostic(&e, tree_file)], sources, a.format),
+        Err(e) => return fail(&[diagnostic(&e, tree_file, sources)], sources, a.format),
     };
     if let Some(path) = &a.faults {
         let mut diags = Vec::new();
@@ -173,7 +183,7 @@ fn execute(
         }
         let added = Scenario::parse(sources.text(f)).and_then(|s| engine.add_faults(&s));
         if let Err(e) = added {
-            return fail(&[diagnostic(&e, f)], sources, a.format);
+            return fail(&[diagnostic(&e, f, sources)], sources, a.format);
         }
     }
     if a.controller {

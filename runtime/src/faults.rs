@@ -107,7 +107,7 @@ struct FileScenario {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct FileFault {
-    kind: String,
+    kind: toml::Spanned<String>,
     name: Option<String>,
     at_tick: Option<u64>,
     on_step: Option<usize>,
@@ -143,12 +143,28 @@ impl Scenario {
         })?;
         let mut faults = Vec::new();
         for (k, f) in file.fault.into_iter().enumerate() {
-            let which = format!("fault {} ({})", k + 1, f.kind);
-            let kind = FaultKind::from_name(&f.kind).ok_or_else(|| {
+            let at = f.kind.span().start;
+            Self::fault(k, f, &mut faults).map_err(|e| e.at_opt(Some(at)))?;
+        }
+        Ok(Scenario {
+            description: file.description,
+            faults,
+        })
+    }
+
+    fn fault(k: usize, f: FileFault, faults: &mut Vec<FaultSpec>) -> Result<(), LoadError> {
+        {
+            let kind_name = f.kind.get_ref().clone();
+            let which = format!("fault {} ({})", k + 1, kind_name);
+            let kind = FaultKind::from_name(&kind_name).ok_or_else(|| {
                 let names: Vec<&str> = FaultKind::ALL.iter().map(|k| k.name()).collect();
-                let mut e = bad(format!("fault {}: `{}` is not a fault kind", k + 1, f.kind));
+                let mut e = bad(format!(
+                    "fault {}: `{}` is not a fault kind",
+                    k + 1,
+                    kind_name
+                ));
                 e = e.hint(
-                    btc_lang::diagnostic::did_you_mean(&f.kind, names.iter().copied())
+                    btc_lang::diagnostic::did_you_mean(&kind_name, names.iter().copied())
                         .unwrap_or_else(|| format!("the kinds are {}", names.join(", "))),
                 );
                 e
@@ -220,10 +236,7 @@ impl Scenario {
                 blackout,
             });
         }
-        Ok(Scenario {
-            description: file.description,
-            faults,
-        })
+        Ok(())
     }
 }
 

@@ -247,11 +247,14 @@ pub fn parse(text: &str) -> Result<TreeDoc, LoadError> {
                 r.error_position() as usize,
             )
         })?;
+        // Where the element's `<` is: the reader stands after its `>`.
+        let end = r.buffer_position() as usize;
         let (start, empty) = match &ev {
-            Event::Start(e) => (Some(elem(e, &r, at)?), false),
-            Event::Empty(e) => (Some(elem(e, &r, at)?), true),
+            Event::Start(e) => (Some(elem(e, &r, end.saturating_sub(e.len() + 2))?), false),
+            Event::Empty(e) => (Some(elem(e, &r, end.saturating_sub(e.len() + 3))?), true),
             _ => (None, false),
         };
+        let at = start.as_ref().map_or(at, |e| e.at);
         if let Some(e) = start {
             match &mut place {
                 Place::Outside => {
