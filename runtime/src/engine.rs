@@ -316,6 +316,8 @@ struct Builder<'d, 'e, 'w> {
     doc: &'d TreeDoc,
     e: &'e mut Engine<'w>,
     instances: FxHashMap<String, u32>,
+    /// The tree instance being built (`Main`, `Check#1`): names new entries.
+    tree: String,
 }
 
 impl<'w> Engine<'w> {
@@ -372,8 +374,9 @@ impl<'w> Engine<'w> {
             doc,
             e: &mut e,
             instances: FxHashMap::default(),
+            tree: doc.main.clone(),
         };
-        b.node(main, &mut scope, None, None, 0, 0, &doc.main)?;
+        b.node(main, &mut scope, None, None, 0, 0)?;
         let n = e.nodes.len();
         e.status = vec![Status::Idle; n];
         e.cur = vec![0; n];
@@ -1254,7 +1257,6 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
         parent: Option<u32>,
         depth: usize,
         calls: usize,
-        tree: &str,
     ) -> Result<u32, LoadError> {
         if depth > MAX_DEPTH {
             return Err(self.err(
@@ -1443,7 +1445,7 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
                 let slot = match v {
                     PortValue::Param(p) => {
                         let p = if p == "=" { k } else { p };
-                        self.slot_in(scope, p, tree)
+                        self.slot_in(scope, p)
                     }
                     other => self
                         .e
@@ -1451,19 +1453,13 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
                 };
                 child.insert(k.clone(), slot);
             }
-            let c = self.node(
-                def,
-                &mut child,
-                my_step,
-                Some(me),
-                depth + 1,
-                calls + 1,
-                &inst,
-            )?;
-            kids.push(c);
+            let outer = std::mem::replace(&mut self.tree, inst);
+            let c = self.node(def, &mut child, my_step, Some(me), depth + 1, calls + 1);
+            self.tree = outer;
+            kids.push(c?);
         } else {
             for c in &n.children {
-                let k = self.node(c, scope, my_step, Some(me), depth + 1, calls, tree)?;
+                let k = self.node(c, scope, my_step, Some(me), depth + 1, calls)?;
                 kids.push(k);
             }
         }
@@ -1477,11 +1473,13 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
         Ok(me)
     }
 
-    fn slot_in(&mut self, scope: &mut Scope, key: &str, tree: &str) -> u32 {
+    fn slot_in(&mut self, scope: &mut Scope, key: &str) -> u32 {
         if let Some(&s) = scope.get(key) {
             return s;
         }
-        let s = self.e.new_slot(format!("{tree}/{key}"), Value::Empty);
+        let s = self
+            .e
+            .new_slot(format!("{}/{key}", self.tree), Value::Empty);
         scope.insert(key.to_owned(), s);
         s
     }
@@ -1498,7 +1496,7 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
             let src = match v {
                 PortValue::Param(p) => {
                     let p = if p == "=" { k.as_str() } else { p.as_str() };
-                    Src::Slot(self.slot_in(scope, p, "?"))
+                    Src::Slot(self.slot_in(scope, p))
                 }
                 other => {
                     let val = Value::from_port(other);
@@ -1592,7 +1590,7 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
                         "`SetBlackboard` needs the port `value`".into(),
                     ));
                 };
-                let slot = self.slot_in(scope, &key, "?");
+                let slot = self.slot_in(scope, &key);
                 let (a, _) = self.bind_ports(n, ports, &|_| None, scope)?;
                 return Ok(Op::SetBlackboard {
                     value: a + vi as u32,
