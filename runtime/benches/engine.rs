@@ -66,7 +66,9 @@ fn sequence_doc(n: usize) -> TreeDoc {
 }
 
 fn monitor_doc(actions: usize, condition: SNode) -> TreeDoc {
-    let acts = (0..actions).map(|_| leaf("Work", LeafKind::Action)).collect();
+    let acts = (0..actions)
+        .map(|_| leaf("Work", LeafKind::Action))
+        .collect();
     doc(node(
         Kind::ReactiveSequence,
         vec![condition, node(Kind::Sequence, acts)],
@@ -119,7 +121,12 @@ const FLAGS_PROBLEM: &str = include_str!("../tests/fixtures/flags/problem.pddl")
 fn reactive_kb_monitor_over_100_actions(b: Bencher) {
     let du = pipeline::domain_unit_from(FLAGS_DOMAIN, 0);
     let pu = pipeline::problem_unit_from(FLAGS_PROBLEM, 1, du.domain.as_ref(), &du.index);
-    let kb = Kb::new(du.domain.as_ref().unwrap(), &du.index, pu.problem.as_ref().unwrap(), &pu.index);
+    let kb = Kb::new(
+        du.domain.as_ref().unwrap(),
+        &du.index,
+        pu.problem.as_ref().unwrap(),
+        &pu.index,
+    );
     let cond = node(
         Kind::Leaf {
             id: "KbHolds".into(),

@@ -404,15 +404,7 @@ impl<'w> Engine<'w> {
     }
 
     fn need_kb(&mut self, what: &str) -> Result<&mut Kb<'w>, LoadError> {
-        self.kb.as_mut().ok_or_else(|| {
-            LoadError::new(
-                codes::X_KB,
-                format!("{what} reads or writes the KB, and no PDDL problem was given"),
-            )
-            .hint(
-                "pass `--problem PROBLEM` (and `--domain DOMAIN` unless it is beside the problem)",
-            )
-        })
+        self.kb.as_mut().ok_or_else(|| no_kb(what))
     }
 
     fn kb_formula(
@@ -576,11 +568,6 @@ impl<'w> Engine<'w> {
             // BT.CPP v4 keeps the index of a halted SequenceWithMemory.
             Op::SequenceWithMemory if self.status[iu] == Status::Running => {}
             _ => self.cur[iu] = 0,
-        }
-        if let Op::Action(_) = def.op {
-            if self.status[iu] == Status::Running && self.cur[iu] == 0 {
-                // cleared above; a pending command's completion is ignored
-            }
         }
         self.aux[iu] = 0;
         self.set(iu, Status::Idle);
@@ -1225,6 +1212,14 @@ impl<'w> Engine<'w> {
     }
 }
 
+fn no_kb(what: &str) -> LoadError {
+    LoadError::new(
+        codes::X_KB,
+        format!("{what} reads or writes the KB, and no PDDL problem was given"),
+    )
+    .hint("pass `--problem PROBLEM` (and `--domain DOMAIN` unless it is beside the problem)")
+}
+
 fn threshold(t: i32, n: i64) -> i64 {
     if t < 0 {
         (n + t as i64 + 1).max(0)
@@ -1654,12 +1649,7 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
             LeafKind::Condition => {
                 let template = model.and_then(|m| m.formula.clone());
                 if template.is_some() && self.e.kb.is_none() {
-                    return Err(self
-                        .e
-                        .need_kb(&format!("the condition `{id}`"))
-                        .err()
-                        .unwrap_or_else(|| LoadError::new(codes::X_KB, "no KB"))
-                        .at_opt(n.at));
+                    return Err(no_kb(&format!("the condition `{id}`")).at_opt(n.at));
                 }
                 let c = self.e.conds.len() as u32;
                 self.e.conds.push(CondInfo {
@@ -1692,5 +1682,54 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
                 Op::Action(a)
             }
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parallel_thresholds_count_from_the_end_when_negative() {
+        assert_eq!(threshold(-1, 5), 5);
+        assert_eq!(threshold(-2, 5), 4);
+        assert_eq!(threshold(2, 5), 2);
+        assert_eq!(threshold(-9, 5), 0);
+    }
+
+    #[test]
+    fn text_converts_to_the_declared_port_type() {
+        let t = |s: &str| Value::Text(s.into());
+        assert_eq!(t(" 42 ").typed("int"), Ok(Value::Int(42)));
+        assert_eq!(t("2.5").typed("float"), Ok(Value::Float(2.5)));
+        assert_eq!(t("true").typed("bool"), Ok(Value::Bool(true)));
+        assert_eq!(t("bin1").typed("container"), Ok(t("bin1")));
+        assert!(t("three").typed("int").is_err());
+        assert_eq!(Value::Int(3).typed("int"), Ok(Value::Int(3)));
+    }
+
+    #[test]
+    fn an_empty_tree_of_one_leaf_runs() {
+        let doc = TreeDoc {
+            main: "M".into(),
+            trees: vec![(
+                "M".into(),
+                SNode {
+                    kind: Kind::Leaf {
+                        id: "AlwaysFailure".into(),
+                        kind: None,
+                        ports: Vec::new(),
+                    },
+                    name: None,
+                    children: Vec::new(),
+                    at: None,
+                },
+            )],
+            ..TreeDoc::default()
+        };
+        let mut e = Engine::build(&doc, None, Options::default()).unwrap();
+        assert_eq!(e.run(10, |_| {}), Status::Failure);
+        assert_eq!(e.records.len(), 1);
+        assert_eq!(e.records[0].reason, "AlwaysFailure");
     }
 }

@@ -417,3 +417,42 @@ pub fn parse(text: &str) -> Result<TreeDoc, LoadError> {
     }
     Ok(doc)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn braces_name_blackboard_entries() {
+        assert_eq!(port_value("{target}"), PortValue::Param("target".into()));
+        assert_eq!(port_value("{=}"), PortValue::Param("=".into()));
+        assert_eq!(port_value("bin1"), PortValue::Text("bin1".into()));
+        assert_eq!(port_value("{"), PortValue::Text("{".into()));
+    }
+
+    #[test]
+    fn errors_point_at_the_element() {
+        let text = "<root BTCPP_format=\"4\">\n  <BehaviorTree ID=\"M\">\n    <Repeat num_cycles=\"x\">\n      <AlwaysSuccess/>\n    </Repeat>\n  </BehaviorTree>\n</root>\n";
+        let e = parse(text).unwrap_err();
+        assert_eq!(e.code.id, "X003");
+        assert_eq!(&text[e.offset.unwrap()..][..7], "<Repeat");
+    }
+
+    #[test]
+    fn v3_files_and_includes_are_refused() {
+        let e = parse("<root BTCPP_format=\"3\"></root>").unwrap_err();
+        assert_eq!(e.code.id, "X001");
+        let e = parse("<root><include path=\"x.xml\"/></root>").unwrap_err();
+        assert!(e.message.contains("include"));
+    }
+
+    #[test]
+    fn models_give_leaf_kinds_ports_and_formulas() {
+        let text = "<root main_tree_to_execute=\"M\"><BehaviorTree ID=\"M\"><Ok robot=\"r\"/></BehaviorTree><TreeNodesModel><Condition ID=\"Ok\" description=\"holds when (ok ?robot)\"><input_port name=\"robot\" type=\"int\"/></Condition></TreeNodesModel></root>";
+        let d = parse(text).unwrap();
+        let m = d.model("Ok").unwrap();
+        assert_eq!(m.kind, LeafKind::Condition);
+        assert_eq!(m.formula.as_deref(), Some("(ok ?robot)"));
+        assert_eq!(m.ports[0].ty, "int");
+    }
+}
