@@ -318,6 +318,8 @@ struct Builder<'d, 'e, 'w> {
     instances: FxHashMap<String, u32>,
     /// The tree instance being built (`Main`, `Check#1`): names new entries.
     tree: String,
+    /// Children of the nodes being built, before they move to `kids`.
+    pending: Vec<u32>,
 }
 
 impl<'w> Engine<'w> {
@@ -375,6 +377,7 @@ impl<'w> Engine<'w> {
             e: &mut e,
             instances: FxHashMap::default(),
             tree: doc.main.clone(),
+            pending: Vec::new(),
         };
         b.node(main, &mut scope, None, None, 0, 0)?;
         let n = e.nodes.len();
@@ -1335,7 +1338,7 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
                 end_effect,
             } => {
                 let k32 = u32::try_from(*k).unwrap_or(u32::MAX);
-                while self.e.steps.len() <= *k && self.e.steps.len() < 1_000_000 {
+                while self.e.steps.len() <= *k && self.e.steps.len() < 100_000 {
                     let idx = self.e.steps.len();
                     self.e.steps.push(StepRt {
                         label: format!("step {}", idx + 1),
@@ -1395,7 +1398,7 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
             m.name = name;
             m.id = id;
         }
-        let mut kids = Vec::new();
+        let mark = self.pending.len();
         if let Kind::SubTree {
             id: tid,
             ports,
@@ -1451,20 +1454,17 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
             let outer = std::mem::replace(&mut self.tree, inst);
             let c = self.node(def, &mut child, my_step, Some(me), depth + 1, calls + 1);
             self.tree = outer;
-            kids.push(c?);
+            self.pending.push(c?);
         } else {
             for c in &n.children {
                 let k = self.node(c, scope, my_step, Some(me), depth + 1, calls)?;
-                kids.push(k);
+                self.pending.push(k);
             }
         }
         let first = self.e.kids.len() as u32;
-        self.e.kids.extend_from_slice(&kids);
-        self.e.nodes[me as usize] = NodeDef {
-            op,
-            first,
-            len: kids.len() as u32,
-        };
+        let len = (self.pending.len() - mark) as u32;
+        self.e.kids.extend(self.pending.drain(mark..));
+        self.e.nodes[me as usize] = NodeDef { op, first, len };
         Ok(me)
     }
 

@@ -85,15 +85,25 @@ fn port_value(v: &str) -> PortValue {
     }
 }
 
-fn ports(e: &Elem, skip: &[&str]) -> Vec<(String, PortValue)> {
-    e.attrs
-        .iter()
+/// The attributes that are ports (all but `name` and `skip`), moved out.
+fn ports(e: &mut Elem, skip: &[&str]) -> Vec<(String, PortValue)> {
+    std::mem::take(&mut e.attrs)
+        .into_iter()
         .filter(|(k, _)| k != "name" && !skip.contains(&k.as_str()))
-        .map(|(k, v)| (k.clone(), port_value(v)))
+        .map(|(k, v)| {
+            let t = v.trim();
+            let pv = if t.len() >= 2 && t.starts_with('{') && t.ends_with('}') {
+                PortValue::Param(t[1..t.len() - 1].trim().to_owned())
+            } else {
+                PortValue::Text(v)
+            };
+            (k, pv)
+        })
         .collect()
 }
 
-fn node_of(e: &Elem) -> Result<SNode, LoadError> {
+fn node_of(mut e: Elem) -> Result<SNode, LoadError> {
+    let name = e.get("name").map(str::to_owned);
     let kind = match e.name.as_str() {
         "Sequence" => Kind::Sequence,
         "ReactiveSequence" => Kind::ReactiveSequence,
@@ -120,10 +130,12 @@ fn node_of(e: &Elem) -> Result<SNode, LoadError> {
             let id = e.get("ID").ok_or_else(|| {
                 LoadError::new(codes::X_BAD_PORT, "<SubTree> needs the attribute `ID`").at(e.at)
             })?;
+            let id = id.to_owned();
+            let autoremap = e.get("_autoremap").is_some_and(|v| v.trim() == "true");
             Kind::SubTree {
-                id: id.to_owned(),
-                ports: ports(e, &["ID", "_autoremap"]),
-                autoremap: e.get("_autoremap").is_some_and(|v| v.trim() == "true"),
+                id,
+                ports: ports(&mut e, &["ID", "_autoremap"]),
+                autoremap,
             }
         }
         "KbStep" => {
@@ -153,25 +165,27 @@ fn node_of(e: &Elem) -> Result<SNode, LoadError> {
                 )
                 .at(e.at)
             })?;
+            let id = id.to_owned();
+            let kind = Some(if e.name == "Action" {
+                LeafKind::Action
+            } else {
+                LeafKind::Condition
+            });
             Kind::Leaf {
-                id: id.to_owned(),
-                kind: Some(if e.name == "Action" {
-                    LeafKind::Action
-                } else {
-                    LeafKind::Condition
-                }),
-                ports: ports(e, &["ID"]),
+                id,
+                kind,
+                ports: ports(&mut e, &["ID"]),
             }
         }
-        other => Kind::Leaf {
-            id: other.to_owned(),
+        _ => Kind::Leaf {
+            id: std::mem::take(&mut e.name),
             kind: None,
-            ports: ports(e, &[]),
+            ports: ports(&mut e, &[]),
         },
     };
     Ok(SNode {
         kind,
-        name: e.get("name").map(str::to_owned),
+        name,
         children: Vec::new(),
         at: Some(e.at),
     })
@@ -321,7 +335,7 @@ pub fn parse(text: &str) -> Result<TreeDoc, LoadError> {
                             at,
                         ));
                     }
-                    let n = node_of(&e)?;
+                    let n = node_of(e)?;
                     if empty {
                         match stack.last_mut() {
                             Some(p) => p.children.push(n),
