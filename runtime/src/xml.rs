@@ -76,12 +76,12 @@ impl Elem {
 
 /// `{key}` is a blackboard entry (`{=}`: the port's own name); anything
 /// else is a literal.
-fn port_value(v: &str) -> PortValue {
+fn port_value(v: String) -> PortValue {
     let t = v.trim();
     if t.len() >= 2 && t.starts_with('{') && t.ends_with('}') {
         PortValue::Param(t[1..t.len() - 1].trim().to_owned())
     } else {
-        PortValue::Text(v.to_owned())
+        PortValue::Text(v)
     }
 }
 
@@ -90,15 +90,7 @@ fn ports(e: &mut Elem, skip: &[&str]) -> Vec<(String, PortValue)> {
     std::mem::take(&mut e.attrs)
         .into_iter()
         .filter(|(k, _)| k != "name" && !skip.contains(&k.as_str()))
-        .map(|(k, v)| {
-            let t = v.trim();
-            let pv = if t.len() >= 2 && t.starts_with('{') && t.ends_with('}') {
-                PortValue::Param(t[1..t.len() - 1].trim().to_owned())
-            } else {
-                PortValue::Text(v)
-            };
-            (k, pv)
-        })
+        .map(|(k, v)| (k, port_value(v)))
         .collect()
 }
 
@@ -438,10 +430,13 @@ mod tests {
 
     #[test]
     fn braces_name_blackboard_entries() {
-        assert_eq!(port_value("{target}"), PortValue::Param("target".into()));
-        assert_eq!(port_value("{=}"), PortValue::Param("=".into()));
-        assert_eq!(port_value("bin1"), PortValue::Text("bin1".into()));
-        assert_eq!(port_value("{"), PortValue::Text("{".into()));
+        assert_eq!(
+            port_value("{target}".into()),
+            PortValue::Param("target".into())
+        );
+        assert_eq!(port_value("{=}".into()), PortValue::Param("=".into()));
+        assert_eq!(port_value("bin1".into()), PortValue::Text("bin1".into()));
+        assert_eq!(port_value("{".into()), PortValue::Text("{".into()));
     }
 
     #[test]
