@@ -1340,8 +1340,11 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
                 let k32 = u32::try_from(*k).unwrap_or(u32::MAX);
                 while self.e.steps.len() <= *k && self.e.steps.len() < 100_000 {
                     let idx = self.e.steps.len();
+                    // A step the tree file names but no plan describes:
+                    // skipped until a KbStep refers to it.
                     self.e.steps.push(StepRt {
                         label: format!("step {}", idx + 1),
+                        skipped: true,
                         ..StepRt::default()
                     });
                 }
@@ -1351,6 +1354,12 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
                         n,
                         format!("step {} is out of range", k + 1),
                     ));
+                }
+                if *k >= self.doc.steps.len() && self.e.steps[*k].skipped {
+                    self.e.steps[*k].skipped = false;
+                    if let Some(nm) = &n.name {
+                        self.derive_step(*k, nm).map_err(|e| e.at_opt(n.at))?;
+                    }
                 }
                 let label = format!("`{}`", self.e.steps[*k].label);
                 if let Some(f) = self
@@ -1466,6 +1475,59 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
         self.e.kids.extend(self.pending.drain(mark..));
         self.e.nodes[me as usize] = NodeDef { op, first, len };
         Ok(me)
+    }
+
+    /// A step known only from a tree file (`KbStep name="step 3: (grasp r
+    /// p bin1)"`): its conditions are the domain action's, grounded.
+    fn derive_step(&mut self, k: usize, name: &str) -> Result<(), LoadError> {
+        let Some(domain) = self.e.kb.as_ref().map(|kb| kb.world.domain) else {
+            return Ok(());
+        };
+        let Some(open) = name.find('(') else {
+            return Ok(());
+        };
+        let inner = name[open + 1..].trim_end().trim_end_matches(')');
+        let mut words = inner.split_whitespace();
+        let Some(act) = words.next().map(str::to_lowercase) else {
+            return Ok(());
+        };
+        let args: Vec<String> = words.map(str::to_lowercase).collect();
+        let Some(a) = domain.actions.iter().find(|a| a.name.name == act) else {
+            return Ok(());
+        };
+        if a.params.len() != args.len() {
+            return Ok(());
+        }
+        let bind = |v: &str| {
+            a.params
+                .iter()
+                .position(|p| p.name.name == v)
+                .map(|i| args[i].clone())
+        };
+        let text = |parts: &[btc_lang::pddl::ast::Formula]| {
+            (!parts.is_empty())
+                .then(|| substitute(&btc_lang::pddl::print::conjunction(parts), bind))
+        };
+        let (pre_start, over_all, pre_end) =
+            (text(&a.pre_start), text(&a.pre_over_all), text(&a.pre_end));
+        let label = format!(
+            "step {}: ({})",
+            k + 1,
+            std::iter::once(act.as_str())
+                .chain(args.iter().map(String::as_str))
+                .collect::<Vec<_>>()
+                .join(" ")
+        );
+        let what = format!("`{label}`");
+        let pre_start = self.e.kb_formula(pre_start.as_deref(), &what)?;
+        let over_all = self.e.kb_formula(over_all.as_deref(), &what)?;
+        let pre_end = self.e.kb_formula(pre_end.as_deref(), &what)?;
+        let st = &mut self.e.steps[k];
+        st.label = label;
+        st.pre_start = pre_start;
+        st.pre_over_all = over_all;
+        st.pre_end = pre_end;
+        Ok(())
     }
 
     fn slot_in(&mut self, scope: &mut Scope, key: &str) -> u32 {

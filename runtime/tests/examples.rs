@@ -61,11 +61,13 @@ fn btcpp_xml_runs_exactly_like_its_ir() {
             };
             from_ir.steps = ex.ir.steps.clone();
             let text = btc_lang::emit::btcpp::emit(&ex.ir, inline);
-            let mut from_xml = xml::parse(&text).unwrap_or_else(|e| panic!("{name}: {e}"));
-            // The XML carries effects, not preconditions: give it the plan.
-            from_xml.steps = ex.ir.steps.clone();
+            // The XML carries the steps' effects; their conditions come
+            // from the domain's actions, as `btc run --tree` does.
+            let from_xml = xml::parse(&text).unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert!(from_xml.steps.is_empty());
             let mut a = ex.engine(&w, &from_ir, traced());
             let mut b = ex.engine(&w, &from_xml, traced());
+            assert_eq!(a.steps_total(), b.steps_total(), "{name}");
             let sa = a.run(100_000, |_| {});
             let sb = b.run(100_000, |_| {});
             assert_eq!(sa, Status::Success, "{name}");
@@ -87,4 +89,29 @@ fn btcpp_xml_runs_exactly_like_its_ir() {
             );
         }
     }
+}
+
+#[test]
+fn xml_steps_check_the_domain_preconditions_like_the_ir() {
+    // A fault that makes the grasp's precondition false: the XML tree (no
+    // plan given) must fail where the IR fails, with the same record.
+    let ex = example("ariac");
+    let w = ex.world();
+    let text = btc_lang::emit::btcpp::emit(&ex.ir, false);
+    let sc_text =
+        std::fs::read_to_string(root().join("examples/ariac/faults/faulty_part.toml")).unwrap();
+    let sc = btc_runtime::Scenario::parse(&sc_text).unwrap();
+    let mut runs = Vec::new();
+    for doc in [TreeDoc::from_ir(&ex.ir), xml::parse(&text).unwrap()] {
+        let mut e = ex.engine(&w, &doc, traced());
+        e.add_faults(&sc).unwrap();
+        assert_eq!(e.run(1000, |_| {}), Status::Failure);
+        runs.push((e.trace_jsonl(), e.records.clone()));
+    }
+    assert!(
+        runs[0].1[0].reason.contains("precondition"),
+        "{:?}",
+        runs[0].1
+    );
+    assert_eq!(runs[0], runs[1]);
 }
