@@ -16,6 +16,9 @@ pub struct Kb<'w> {
     pub state: State,
     problem: &'w Problem,
     formulas: Vec<Formula>,
+    /// For formulas that are ground literals (or a conjunction of them):
+    /// the atom keys, so checking them allocates nothing.
+    literals: Vec<Option<Vec<Literal>>>,
     effects: Vec<Effect>,
     formula_ids: FxHashMap<String, FormulaId>,
     effect_ids: FxHashMap<String, EffectId>,
@@ -38,6 +41,7 @@ impl<'w> Kb<'w> {
             state,
             problem,
             formulas: Vec::new(),
+            literals: Vec::new(),
             effects: Vec::new(),
             formula_ids: FxHashMap::default(),
             effect_ids: FxHashMap::default(),
@@ -85,6 +89,9 @@ impl<'w> Kb<'w> {
             return Err(d.message.clone());
         }
         let id = self.formulas.len() as FormulaId;
+        let mut lits = Vec::new();
+        let lits = self.literals_of(&f, true, &mut lits).then_some(lits);
+        self.literals.push(lits);
         self.formulas.push(f);
         self.formula_ids.insert(text.to_owned(), id);
         Ok(id)
@@ -118,12 +125,47 @@ impl<'w> Kb<'w> {
     }
 
     pub fn holds(&self, f: FormulaId) -> bool {
+        if let Some(lits) = &self.literals[f as usize] {
+            return lits.iter().all(|l| {
+                let set = if l.derived {
+                    &self.state.derived
+                } else {
+                    &self.state.facts
+                };
+                set.contains(&l.key) == l.positive
+            });
+        }
         self.world.holds(
             &self.state,
             &self.formulas[f as usize],
             &mut Env::new(),
             None,
         )
+    }
+
+    /// Collects `f` as ground literals; false when it is anything else.
+    fn literals_of(&self, f: &Formula, positive: bool, out: &mut Vec<Literal>) -> bool {
+        match f {
+            Formula::Atom { atom } => {
+                let Some(sig) = self.world.dix.predicates.get(atom.pred.as_str()) else {
+                    return false;
+                };
+                let Some(key) = self.world.atom_key(atom, &Env::new()) else {
+                    return false;
+                };
+                out.push(Literal {
+                    key,
+                    positive,
+                    derived: self.world.is_derived(sig.index as u32),
+                });
+                true
+            }
+            Formula::Not { formula, .. } if positive => self.literals_of(formula, false, out),
+            Formula::And { parts, .. } if positive => {
+                parts.iter().all(|p| self.literals_of(p, true, out))
+            }
+            _ => false,
+        }
     }
 
     /// Why `f` does not hold, in the user's terms.
@@ -241,6 +283,12 @@ impl<'w> Kb<'w> {
     }
 }
 
+struct Literal {
+    key: Key,
+    positive: bool,
+    derived: bool,
+}
+
 /// Fills `?var` occurrences in PDDL text from `value` (token-aware: `?a`
 /// does not touch `?ab`); unknown variables stay.
 pub fn substitute(text: &str, value: impl Fn(&str) -> Option<String>) -> String {
@@ -268,7 +316,40 @@ pub fn substitute(text: &str, value: impl Fn(&str) -> Option<String>) -> String 
 
 #[cfg(test)]
 mod tests {
-    use super::substitute;
+    use super::*;
+    use btc_lang::pipeline;
+
+    #[test]
+    fn ground_literals_take_the_fast_path_with_the_same_answers() {
+        let du = pipeline::domain_unit_from(include_str!("../tests/fixtures/flags/domain.pddl"), 0);
+        let pu = pipeline::problem_unit_from(
+            include_str!("../tests/fixtures/flags/problem.pddl"),
+            1,
+            du.domain.as_ref(),
+            &du.index,
+        );
+        let mut kb = Kb::new(
+            du.domain.as_ref().unwrap(),
+            &du.index,
+            pu.problem.as_ref().unwrap(),
+            &pu.index,
+        );
+        for (text, fast, expect) in [
+            ("(at r1 bin1)", true, true),
+            ("(and (at r1 bin1) (not (go)))", true, true),
+            ("(and (at r1 bin2) (not (go)))", true, false),
+            ("(or (go) (at r1 bin1))", false, true),
+            ("(not (and (go) (done)))", false, true),
+        ] {
+            let f = kb.formula(text).unwrap();
+            assert_eq!(kb.literals[f as usize].is_some(), fast, "{text}");
+            assert_eq!(kb.holds(f), expect, "{text}");
+            let slow = kb
+                .world
+                .holds(&kb.state, &kb.formulas[f as usize], &mut Env::new(), None);
+            assert_eq!(slow, expect, "{text}");
+        }
+    }
 
     #[test]
     fn substitution_is_token_aware() {
