@@ -230,3 +230,54 @@ fn usage_and_io_errors_exit_2() {
     let out = btc(&["run"]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+#[test]
+fn a_tree_that_never_finishes_is_halted_after_max_ticks() {
+    let out = btc(&[
+        "run",
+        "--tree",
+        "tests/fixtures/run/forever.xml",
+        "--max-ticks",
+        "50",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let s = summary(&out);
+    assert_eq!(s["status"], "RUNNING");
+    assert_eq!(s["ticks"], 50);
+    let reason = s["records"][0]["reason"].as_str().unwrap();
+    assert!(reason.contains("still running after 50 ticks"), "{reason}");
+}
+
+#[test]
+fn an_xml_tree_checks_step_preconditions_from_the_domain() {
+    let dir = tempfile::tempdir().unwrap();
+    let tree = dir.path().join("tree.xml");
+    let out = btc(&[
+        "compile",
+        "examples/ariac/rules.btrules",
+        "--plan",
+        "examples/ariac/plan.txt",
+        "--emit",
+        "btcpp",
+        "-o",
+        tree.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0));
+    let out = btc(&[
+        "run",
+        "--tree",
+        tree.to_str().unwrap(),
+        "--problem",
+        "examples/ariac/problem.pddl",
+        "--faults",
+        "examples/ariac/faults/insufficient_parts.toml",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("its step's precondition does not hold: `(on battery_red bin1)` is false"),
+        "{text}"
+    );
+}

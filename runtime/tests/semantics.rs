@@ -339,3 +339,13 @@ fn halted_actions_start_over() {
     // Three full ticks of running again, not the one that was left.
     assert_eq!(ticks(&mut e, 4), [Running, Running, Running, Success]);
 }
+
+#[test]
+fn retry_forever_makes_one_attempt_per_tick() {
+    let w = flags();
+    let mut e = engine(&w, "retry_forever", 1);
+    assert_eq!(ticks(&mut e, 3), [Running, Running, Running]);
+    assert_eq!(starts(&e, "go?"), 3);
+    set(&mut e, "(go)", true);
+    assert_eq!(ticks(&mut e, 1), [Success]);
+}
