@@ -697,10 +697,19 @@ impl<'w> Engine<'w> {
                 }
                 match (def.op, s) {
                     (_, Status::Running) => Status::Running,
-                    (Op::Inverter, Status::Success) => Status::Failure,
+                    (Op::Inverter, Status::Success) => {
+                        self.note_failure(
+                            i,
+                            Reason::Plain("its child succeeded (Inverter)".into()),
+                        );
+                        Status::Failure
+                    }
                     (Op::Inverter, _) => Status::Success,
                     (Op::ForceSuccess, _) => Status::Success,
-                    (Op::ForceFailure, _) => Status::Failure,
+                    (Op::ForceFailure, _) => {
+                        self.note_failure(i, Reason::Plain("ForceFailure".into()));
+                        Status::Failure
+                    }
                     (Op::KeepRunningUntilFailure, Status::Success) => Status::Running,
                     (_, s) => s,
                 }
@@ -1768,6 +1777,52 @@ mod tests {
         assert_eq!(t("bin1").typed("container"), Ok(t("bin1")));
         assert!(t("three").typed("int").is_err());
         assert_eq!(Value::Int(3).typed("int"), Ok(Value::Int(3)));
+    }
+
+    fn leaf(id: &str) -> SNode {
+        SNode {
+            kind: Kind::Leaf {
+                id: id.into(),
+                kind: None,
+                ports: Vec::new(),
+            },
+            name: None,
+            children: Vec::new(),
+            at: None,
+        }
+    }
+
+    #[test]
+    fn a_failure_made_by_a_decorator_is_recorded_as_its_own() {
+        // An earlier, recovered failure must not be blamed.
+        let fallback = SNode {
+            kind: Kind::Fallback,
+            name: None,
+            children: vec![leaf("AlwaysFailure"), leaf("AlwaysSuccess")],
+            at: None,
+        };
+        let inverter = SNode {
+            kind: Kind::Inverter,
+            name: Some("not done".into()),
+            children: vec![leaf("AlwaysSuccess")],
+            at: None,
+        };
+        let root = SNode {
+            kind: Kind::Sequence,
+            name: None,
+            children: vec![fallback, inverter],
+            at: None,
+        };
+        let doc = TreeDoc {
+            main: "M".into(),
+            trees: vec![("M".into(), root)],
+            ..TreeDoc::default()
+        };
+        let mut e = Engine::build(&doc, None, Options::default()).unwrap();
+        assert_eq!(e.run(10, |_| {}), Status::Failure);
+        assert_eq!(e.records.len(), 1);
+        assert_eq!(e.records[0].node_name, "not done");
+        assert_eq!(e.records[0].reason, "its child succeeded (Inverter)");
     }
 
     #[test]
