@@ -26,6 +26,8 @@ pub struct Controller {
     tx: Option<SyncSender<Command>>,
     done_rx: Receiver<u64>,
     done: FxHashSet<u64>,
+    /// Commands whose completion nobody waits for any more.
+    forgotten: FxHashSet<u64>,
     next: u64,
     /// Completions received so far.
     received: u64,
@@ -58,6 +60,7 @@ impl Controller {
             tx: Some(tx),
             done_rx,
             done: FxHashSet::default(),
+            forgotten: FxHashSet::default(),
             next: 0,
             received: 0,
             worker,
@@ -82,7 +85,21 @@ impl Controller {
     pub fn poll(&mut self) {
         while let Ok(seq) = self.done_rx.try_recv() {
             self.received += 1;
+            self.complete(seq);
+        }
+    }
+
+    fn complete(&mut self, seq: u64) {
+        if !self.forgotten.remove(&seq) {
             self.done.insert(seq);
+        }
+    }
+
+    /// Nobody waits for command `seq` any more (its leaf was halted): it
+    /// still executes, and its completion is dropped.
+    pub fn forget(&mut self, seq: u64) {
+        if !self.done.remove(&seq) {
+            self.forgotten.insert(seq);
         }
     }
 
@@ -97,7 +114,7 @@ impl Controller {
             match self.done_rx.recv() {
                 Ok(s) => {
                     self.received += 1;
-                    self.done.insert(s);
+                    self.complete(s);
                 }
                 Err(_) => return,
             }
@@ -114,7 +131,7 @@ impl Controller {
         }
         if let Ok(s) = self.done_rx.recv_timeout(timeout) {
             self.received += 1;
-            self.done.insert(s);
+            self.complete(s);
         }
     }
 

@@ -570,6 +570,13 @@ impl<'w> Engine<'w> {
         match def.op {
             // BT.CPP v4 keeps the index of a halted SequenceWithMemory.
             Op::SequenceWithMemory if self.status[iu] == Status::Running => {}
+            // A halted action's command still runs; its completion is moot.
+            Op::Action(_) if self.cur[iu] == 2 => {
+                if let Some(c) = self.controller.as_mut() {
+                    c.forget(self.aux[iu]);
+                }
+                self.cur[iu] = 0;
+            }
             _ => self.cur[iu] = 0,
         }
         self.aux[iu] = 0;

@@ -122,3 +122,54 @@ fn dropping_an_engine_with_commands_in_flight_shuts_down_cleanly() {
     // The consumer drains what was queued (20 ms of work) and stops.
     assert!(started.elapsed() < Duration::from_secs(5));
 }
+
+#[test]
+fn halted_leaves_commands_still_run_once_and_are_not_waited_for() {
+    // Each cycle: the sleep finishes first and the parallel halts the
+    // action that waits for its command.
+    let sleep = SNode {
+        kind: Kind::Leaf {
+            id: "Sleep".into(),
+            kind: None,
+            ports: vec![("msec".into(), btc_lang::ir::PortValue::Int(10))],
+        },
+        name: None,
+        children: Vec::new(),
+        at: None,
+    };
+    let par = SNode {
+        kind: Kind::Parallel {
+            success: 1,
+            failure: 1,
+        },
+        name: None,
+        children: vec![sleep, leaf(0)],
+        at: None,
+    };
+    let root = SNode {
+        kind: Kind::Repeat(3),
+        name: None,
+        children: vec![par],
+        at: None,
+    };
+    let mut e = Engine::build(
+        &doc(root),
+        None,
+        Options {
+            trace: true,
+            ..Options::default()
+        },
+    )
+    .unwrap();
+    e.attach_controller(Controller::start(4, Duration::from_millis(20)));
+    assert_eq!(e.run(10_000, |_| {}), Status::Success);
+    let halted = e
+        .trace
+        .iter()
+        .filter(|t| matches!(t, btc_runtime::engine::TraceItem::Status { node, from: Status::Running, to: Status::Idle, .. } if e.meta[*node as usize].name == "work 0"))
+        .count();
+    assert_eq!(halted, 3);
+    let log = e.take_controller().unwrap().shutdown();
+    let seqs: Vec<u64> = log.iter().map(|c| c.seq).collect();
+    assert_eq!(seqs, [1, 2, 3]);
+}
