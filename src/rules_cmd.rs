@@ -103,18 +103,24 @@ pub struct CompileArgs {
     pub format: Format,
 }
 
-pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
+/// Loads a rules file, a plan, and the problem and domain (given, named by
+/// the rules file, or `problem.pddl` beside the plan or the rules) into a
+/// fresh database; file-level problems go to `diags`.
+pub fn load_job(
+    rules_path: &Path,
+    plan_path: &Path,
+    problem_path: Option<&Path>,
+    domain_path: Option<&Path>,
+    diags: &mut Vec<Diagnostic>,
+) -> anyhow::Result<(Database, CompileJob)> {
     let mut database = Database::new();
-    let mut diags = Vec::new();
-    let rules = load_rules(&mut database, &a.rules, &mut diags)?;
-    let plan = files::load_into_db(&mut database, &a.plan, &mut diags)?;
-    // The problem: given, named by the rules file, or `problem.pddl` beside
-    // the plan or the rules.
-    let problem_path = a.problem.clone().or_else(|| {
+    let rules = load_rules(&mut database, rules_path, diags)?;
+    let plan = files::load_into_db(&mut database, plan_path, diags)?;
+    let problem_path = problem_path.map(Path::to_path_buf).or_else(|| {
         if db::declared_path(&database, rules, true).is_some() {
             return None;
         }
-        [a.plan.parent(), a.rules.parent()]
+        [plan_path.parent(), rules_path.parent()]
             .into_iter()
             .flatten()
             .map(|d| d.join("problem.pddl"))
@@ -122,15 +128,25 @@ pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
     });
     let problem = problem_path
         .as_deref()
-        .map(|p| files::load_into_db(&mut database, p, &mut diags))
+        .map(|p| files::load_into_db(&mut database, p, diags))
         .transpose()?;
-    let domain = a
-        .domain
-        .as_deref()
-        .map(|p| files::load_into_db(&mut database, p, &mut diags))
+    let domain = domain_path
+        .map(|p| files::load_into_db(&mut database, p, diags))
         .transpose()?;
     let job = CompileJob::new(&database, rules, plan, problem, domain);
     diags.extend(db::job_diagnostics(&database, job).iter().cloned());
+    Ok((database, job))
+}
+
+pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
+    let mut diags = Vec::new();
+    let (database, job) = load_job(
+        &a.rules,
+        &a.plan,
+        a.problem.as_deref(),
+        a.domain.as_deref(),
+        &mut diags,
+    )?;
     let result = if has_errors(&diags) {
         None
     } else {

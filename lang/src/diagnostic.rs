@@ -237,5 +237,13 @@ pub mod codes {
         R_UNKNOWN_TYPE = "R021", "a port type that is neither a PDDL type nor a basic type";
         R_PLAN_BLOCK = "R022", "a `plan` block that is missing, repeated or has no `steps`";
         R_BAD_ARGUMENT = "R023", "a control or decorator argument that makes no sense";
+        // Running trees (btc run)
+        X_TREE_SYNTAX = "X001", "a behavior tree file that is not BT.CPP v4 XML or btc's JSON IR";
+        X_UNKNOWN_NODE = "X002", "a tree node that is neither built in nor declared";
+        X_BAD_PORT = "X003", "a node attribute or port value the runtime cannot use";
+        X_SUBTREE = "X004", "a SubTree that is not defined, or that calls itself";
+        X_KB = "X005", "a KB formula or effect in a tree that does not fit the problem";
+        X_SCENARIO = "X006", "a fault scenario file that is not valid";
+        X_TOO_DEEP = "X007", "a tree nested deeper than the runtime runs";
     }
 }

@@ -1,0 +1,227 @@
+//! Engine benchmarks (`cargo bench -p btc-runtime`):
+//! - a Sequence of 1,000 `AlwaysSuccess` leaves ticked to completion
+//!   10,000 times (target: 15 ns or less per leaf tick);
+//! - a ReactiveSequence of one condition over a Sequence of 100 actions
+//!   (the ARIAC monitor shape), with actions that finish at once and with
+//!   actions that run for a tick, and with a KB condition;
+//! - loading a 10,000-node BT.CPP XML tree (target: under 10 ms).
+//!
+//! After divan's table, `main` prints the per-leaf figures directly.
+
+use btc_lang::ir::{LeafKind, PortValue};
+use btc_lang::pipeline;
+use btc_runtime::spec::{Kind, SNode, TreeDoc};
+use btc_runtime::{xml, Engine, Kb, Options, Status};
+use divan::counter::ItemsCount;
+use divan::Bencher;
+use std::time::Instant;
+
+// The same allocator as the `btc` binary.
+#[global_allocator]
+static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
+fn main() {
+    divan::main();
+    report();
+}
+
+fn node(kind: Kind, children: Vec<SNode>) -> SNode {
+    SNode {
+        kind,
+        name: None,
+        children,
+        at: None,
+    }
+}
+
+fn leaf(id: &str, kind: LeafKind) -> SNode {
+    node(
+        Kind::Leaf {
+            id: id.into(),
+            kind: Some(kind),
+            ports: vec![("robot".into(), PortValue::Text("floor_robot".into()))],
+        },
+        Vec::new(),
+    )
+}
+
+fn doc(root: SNode) -> TreeDoc {
+    TreeDoc {
+        main: "Main".into(),
+        trees: vec![("Main".into(), root)],
+        ..TreeDoc::default()
+    }
+}
+
+fn sequence_doc(n: usize) -> TreeDoc {
+    let kids = (0..n)
+        .map(|_| {
+            node(
+                Kind::Leaf {
+                    id: "AlwaysSuccess".into(),
+                    kind: None,
+                    ports: Vec::new(),
+                },
+                Vec::new(),
+            )
+        })
+        .collect();
+    doc(node(Kind::Sequence, kids))
+}
+
+fn monitor_doc(actions: usize, condition: SNode) -> TreeDoc {
+    let acts = (0..actions)
+        .map(|_| leaf("Work", LeafKind::Action))
+        .collect();
+    doc(node(
+        Kind::ReactiveSequence,
+        vec![condition, node(Kind::Sequence, acts)],
+    ))
+}
+
+fn opts(ticks_per_action: u32) -> Options {
+    Options {
+        ticks_per_action,
+        ms_per_tick: 10,
+        trace: false,
+    }
+}
+
+/// Ticks to completion; returns the number of ticks.
+fn complete(e: &mut Engine) -> u64 {
+    let mut n = 0;
+    loop {
+        n += 1;
+        if e.tick_once() != Status::Running {
+            return n;
+        }
+    }
+}
+
+#[divan::bench(sample_count = 100, sample_size = 100)]
+fn sequence_of_1000_always_success(b: Bencher) {
+    let mut e = Engine::build(&sequence_doc(1000), None, opts(0)).unwrap();
+    b.counter(ItemsCount::new(1000usize))
+        .bench_local(|| complete(&mut e));
+}
+
+/// Leaf ticks per completion: 101 with actions that finish at once; with
+/// one-tick actions 101 ticks of (condition + finishing action + starting
+/// action) minus the ends: 101 + 200.
+#[divan::bench(args = [0, 1])]
+fn reactive_monitor_over_100_actions(b: Bencher, ticks_per_action: u32) {
+    let d = monitor_doc(100, leaf("Ready", LeafKind::Condition));
+    let mut e = Engine::build(&d, None, opts(ticks_per_action)).unwrap();
+    let leaf_ticks = if ticks_per_action == 0 { 101 } else { 301 };
+    b.counter(ItemsCount::new(leaf_ticks as usize))
+        .bench_local(|| complete(&mut e));
+}
+
+const FLAGS_DOMAIN: &str = include_str!("../tests/fixtures/flags/domain.pddl");
+const FLAGS_PROBLEM: &str = include_str!("../tests/fixtures/flags/problem.pddl");
+
+/// The same with a KB condition, `(at r1 bin1)`, evaluated every tick.
+#[divan::bench]
+fn reactive_kb_monitor_over_100_actions(b: Bencher) {
+    let du = pipeline::domain_unit_from(FLAGS_DOMAIN, 0);
+    let pu = pipeline::problem_unit_from(FLAGS_PROBLEM, 1, du.domain.as_ref(), &du.index);
+    let kb = Kb::new(
+        du.domain.as_ref().unwrap(),
+        &du.index,
+        pu.problem.as_ref().unwrap(),
+        &pu.index,
+    );
+    let cond = node(
+        Kind::Leaf {
+            id: "KbHolds".into(),
+            kind: None,
+            ports: vec![("formula".into(), PortValue::Text("(at r1 bin1)".into()))],
+        },
+        Vec::new(),
+    );
+    let mut e = Engine::build(&monitor_doc(100, cond), Some(kb), opts(1)).unwrap();
+    b.counter(ItemsCount::new(301usize))
+        .bench_local(|| complete(&mut e));
+}
+
+/// A 10,001-node document: 100 sequences of 99 leaves (ARIAC actions with
+/// ports, and built-ins), with its node models.
+fn big_xml() -> String {
+    let mut s = String::from(
+        "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<root BTCPP_format=\"4\" main_tree_to_execute=\"Main\">\n  <BehaviorTree ID=\"Main\">\n    <Sequence>\n",
+    );
+    for i in 0..100 {
+        s.push_str(&format!("      <Sequence name=\"part {i}\">\n"));
+        for j in 0..99 {
+            match j % 3 {
+                0 => s.push_str(&format!(
+                    "        <MoveTo robot=\"floor_robot\" target=\"bin{j}\"/>\n"
+                )),
+                1 => s.push_str(&format!(
+                    "        <Grasp name=\"grasp {i}.{j}\" robot=\"floor_robot\" part=\"part{j}\" source=\"bin{j}\"/>\n"
+                )),
+                _ => s.push_str("        <AlwaysSuccess/>\n"),
+            }
+        }
+        s.push_str("      </Sequence>\n");
+    }
+    s.push_str("    </Sequence>\n  </BehaviorTree>\n  <TreeNodesModel>\n");
+    s.push_str("    <Action ID=\"MoveTo\">\n      <input_port name=\"robot\" type=\"std::string\"/>\n      <input_port name=\"target\" type=\"std::string\"/>\n    </Action>\n");
+    s.push_str("    <Action ID=\"Grasp\">\n      <input_port name=\"robot\" type=\"std::string\"/>\n      <input_port name=\"part\" type=\"std::string\"/>\n      <input_port name=\"source\" type=\"std::string\"/>\n    </Action>\n");
+    s.push_str("  </TreeNodesModel>\n</root>\n");
+    s
+}
+
+#[divan::bench(sample_count = 50)]
+fn load_10000_node_xml(b: Bencher) {
+    let text = big_xml();
+    b.bench_local(|| {
+        let d = xml::parse(&text).unwrap();
+        let e = Engine::build(&d, None, opts(1)).unwrap();
+        assert_eq!(e.node_count(), 10_001);
+        e.node_count()
+    });
+}
+
+/// The figures the issue asks for, measured plainly.
+fn report() {
+    let mut e = Engine::build(&sequence_doc(1000), None, opts(0)).unwrap();
+    complete(&mut e);
+    let t = Instant::now();
+    for _ in 0..10_000 {
+        complete(&mut e);
+    }
+    let ns = t.elapsed().as_nanos() as f64 / (10_000.0 * 1000.0);
+    println!("Sequence of 1,000 AlwaysSuccess, 10,000 completions: {ns:.2} ns per leaf tick");
+
+    for tpa in [0, 1] {
+        let d = monitor_doc(100, leaf("Ready", LeafKind::Condition));
+        let mut e = Engine::build(&d, None, opts(tpa)).unwrap();
+        let leaf_ticks = if tpa == 0 { 101.0 } else { 301.0 };
+        complete(&mut e);
+        let t = Instant::now();
+        for _ in 0..10_000 {
+            complete(&mut e);
+        }
+        let ns = t.elapsed().as_nanos() as f64 / (10_000.0 * leaf_ticks);
+        println!(
+            "ReactiveSequence(condition, Sequence of 100 actions), {tpa} tick(s) per action: {ns:.2} ns per leaf tick"
+        );
+    }
+
+    let text = big_xml();
+    let t = Instant::now();
+    let runs = 20;
+    for _ in 0..runs {
+        let d = xml::parse(&text).unwrap();
+        let e = Engine::build(&d, None, opts(1)).unwrap();
+        assert_eq!(e.node_count(), 10_001);
+    }
+    let ms = t.elapsed().as_secs_f64() * 1000.0 / runs as f64;
+    let t = Instant::now();
+    for _ in 0..runs {
+        xml::parse(&text).unwrap();
+    }
+    let parse = t.elapsed().as_secs_f64() * 1000.0 / runs as f64;
+    println!("Load a 10,001-node XML tree: {ms:.2} ms (parse {parse:.2} ms, build the rest)");
+}

@@ -1,0 +1,596 @@
+//! Injected faults: the eight ARIAC 2023 agility challenges in symbolic
+//! form, read from a TOML scenario file (format in `docs/runtime.md`).
+
+use crate::engine::{Engine, Reason, Status, TraceItem};
+use crate::error::LoadError;
+use crate::kb::FormulaId;
+use btc_lang::diagnostic::codes;
+use btc_lang::state::Key;
+use serde::{Deserialize, Serialize};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FaultKind {
+    RobotMalfunction,
+    FaultyGripper,
+    FaultyPart,
+    FlippedPart,
+    SensorBlackout,
+    HighPriorityOrder,
+    InsufficientParts,
+    HumanTooClose,
+}
+
+impl FaultKind {
+    pub const ALL: [FaultKind; 8] = [
+        FaultKind::RobotMalfunction,
+        FaultKind::FaultyGripper,
+        FaultKind::FaultyPart,
+        FaultKind::FlippedPart,
+        FaultKind::SensorBlackout,
+        FaultKind::HighPriorityOrder,
+        FaultKind::InsufficientParts,
+        FaultKind::HumanTooClose,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            FaultKind::RobotMalfunction => "robot_malfunction",
+            FaultKind::FaultyGripper => "faulty_gripper",
+            FaultKind::FaultyPart => "faulty_part",
+            FaultKind::FlippedPart => "flipped_part",
+            FaultKind::SensorBlackout => "sensor_blackout",
+            FaultKind::HighPriorityOrder => "high_priority_order",
+            FaultKind::InsufficientParts => "insufficient_parts",
+            FaultKind::HumanTooClose => "human_too_close",
+        }
+    }
+
+    fn from_name(s: &str) -> Option<FaultKind> {
+        FaultKind::ALL.into_iter().find(|k| k.name() == s)
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Trigger {
+    /// At the start of tick N (1-based).
+    Tick(u64),
+    /// When plan step N (0-based here) starts.
+    Step(usize),
+    /// When an action leaf with this ID starts for the `occurrence`-th time.
+    Action { id: String, occurrence: u32 },
+}
+
+/// What a blackout makes conditions return.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Blackout {
+    Running,
+    Failure,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct FaultSpec {
+    pub kind: FaultKind,
+    pub name: Option<String>,
+    pub trigger: Trigger,
+    pub robot: Option<String>,
+    pub part: Option<String>,
+    pub duration: Option<u64>,
+    pub retract: Option<Vec<String>>,
+    pub add: Vec<String>,
+    pub goal: Option<String>,
+    pub blackout: Blackout,
+}
+
+impl FaultSpec {
+    pub fn label(&self) -> String {
+        self.name
+            .clone()
+            .unwrap_or_else(|| self.kind.name().to_owned())
+    }
+}
+
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Scenario {
+    pub description: Option<String>,
+    pub faults: Vec<FaultSpec>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileScenario {
+    description: Option<String>,
+    #[serde(default)]
+    fault: Vec<FileFault>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileFault {
+    kind: toml::Spanned<String>,
+    name: Option<String>,
+    at_tick: Option<u64>,
+    on_step: Option<usize>,
+    on_action: Option<String>,
+    occurrence: Option<u32>,
+    robot: Option<String>,
+    part: Option<String>,
+    duration: Option<u64>,
+    retract: Option<Vec<String>>,
+    #[serde(default)]
+    add: Vec<String>,
+    goal: Option<String>,
+    conditions: Option<String>,
+}
+
+fn bad(msg: impl Into<String>) -> LoadError {
+    LoadError::new(codes::X_SCENARIO, msg)
+}
+
+impl Scenario {
+    /// Reads a scenario file's text.
+    pub fn parse(text: &str) -> Result<Scenario, LoadError> {
+        let file: FileScenario = toml::from_str(text).map_err(|e| {
+            let mut err = bad(format!(
+                "this fault scenario is not valid: {}",
+                e.message().trim()
+            ))
+            .hint("see the scenario format in docs/runtime.md");
+            if let Some(sp) = e.span() {
+                err = err.at(sp.start);
+            }
+            err
+        })?;
+        let mut faults = Vec::new();
+        for (k, f) in file.fault.into_iter().enumerate() {
+            let at = f.kind.span().start;
+            Self::fault(k, f, &mut faults).map_err(|e| e.at_opt(Some(at)))?;
+        }
+        Ok(Scenario {
+            description: file.description,
+            faults,
+        })
+    }
+
+    fn fault(k: usize, f: FileFault, faults: &mut Vec<FaultSpec>) -> Result<(), LoadError> {
+        {
+            let kind_name = f.kind.get_ref().clone();
+            let which = format!("fault {} ({})", k + 1, kind_name);
+            let kind = FaultKind::from_name(&kind_name).ok_or_else(|| {
+                let names: Vec<&str> = FaultKind::ALL.iter().map(|k| k.name()).collect();
+                let mut e = bad(format!(
+                    "fault {}: `{}` is not a fault kind",
+                    k + 1,
+                    kind_name
+                ));
+                e = e.hint(
+                    btc_lang::diagnostic::did_you_mean(&kind_name, names.iter().copied())
+                        .unwrap_or_else(|| format!("the kinds are {}", names.join(", "))),
+                );
+                e
+            })?;
+            let trigger = match (f.at_tick, f.on_step, f.on_action) {
+                (Some(t), None, None) if t >= 1 => Trigger::Tick(t),
+                (None, Some(s), None) if s >= 1 => Trigger::Step(s - 1),
+                (None, None, Some(a)) => Trigger::Action {
+                    id: a,
+                    occurrence: f.occurrence.unwrap_or(1).max(1),
+                },
+                (Some(0), None, None) | (None, Some(0), None) => {
+                    return Err(bad(format!("{which}: ticks and steps count from 1")))
+                }
+                _ => {
+                    return Err(bad(format!(
+                        "{which}: give exactly one trigger: `at_tick`, `on_step` or `on_action`"
+                    )))
+                }
+            };
+            let need = |what: &str, v: &Option<String>| -> Result<(), LoadError> {
+                if v.is_none() {
+                    return Err(bad(format!("{which}: this kind needs `{what}`")));
+                }
+                Ok(())
+            };
+            match kind {
+                FaultKind::RobotMalfunction | FaultKind::HumanTooClose => {
+                    need("robot", &f.robot)?;
+                    if f.duration.is_none() {
+                        return Err(bad(format!("{which}: this kind needs `duration` (ticks)")));
+                    }
+                }
+                FaultKind::FaultyGripper => need("robot", &f.robot)?,
+                FaultKind::FaultyPart | FaultKind::InsufficientParts => need("part", &f.part)?,
+                FaultKind::FlippedPart => {
+                    if f.retract.as_ref().is_none_or(Vec::is_empty) || f.add.is_empty() {
+                        return Err(bad(format!(
+                            "{which}: say how the part lies flipped: `retract` and `add` facts"
+                        )));
+                    }
+                }
+                FaultKind::SensorBlackout => {
+                    if f.duration.is_none() {
+                        return Err(bad(format!("{which}: this kind needs `duration` (ticks)")));
+                    }
+                }
+                FaultKind::HighPriorityOrder => need("goal", &f.goal)?,
+            }
+            let blackout = match f.conditions.as_deref() {
+                None | Some("running") => Blackout::Running,
+                Some("failure") => Blackout::Failure,
+                Some(o) => {
+                    return Err(bad(format!(
+                        "{which}: `conditions = \"{o}\"`: say \"running\" or \"failure\""
+                    )))
+                }
+            };
+            faults.push(FaultSpec {
+                kind,
+                name: f.name,
+                trigger,
+                robot: f.robot,
+                part: f.part,
+                duration: f.duration,
+                retract: f.retract,
+                add: f.add,
+                goal: f.goal,
+                blackout,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// A fault at run time.
+pub(crate) struct FaultRt {
+    pub spec: FaultSpec,
+    pub met_at: Option<u64>,
+    /// The tick at which its effect ends.
+    pub until: Option<u64>,
+    pub ended: bool,
+    seen: u32,
+    pending_fail: bool,
+    /// Facts it removed and added (to undo, and to attribute failures).
+    removed: Vec<Key>,
+    added: Vec<Key>,
+    shown: Vec<String>,
+    goal: Option<FormulaId>,
+}
+
+/// How a fault ended, for the summary.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FaultOutcome {
+    pub fault: String,
+    pub kind: FaultKind,
+    pub met_at: Option<u64>,
+    /// `not met`, `recovered` or `not recovered: REASON`.
+    pub ended: String,
+}
+
+impl<'w> Engine<'w> {
+    /// Arms a scenario's faults; their facts and goals are checked against
+    /// the problem.
+    pub fn add_faults(&mut self, s: &Scenario) -> Result<(), LoadError> {
+        for spec in &s.faults {
+            let label = spec.label();
+            let mut goal = None;
+            if let Some(g) = &spec.goal {
+                let kb = self
+                    .kb
+                    .as_mut()
+                    .ok_or_else(|| bad("faults need a PDDL problem"))?;
+                goal = Some(kb.formula(g).map_err(|m| {
+                    bad(format!(
+                        "fault `{label}`: goal `{g}` is not a condition of this problem: {m}"
+                    ))
+                })?);
+            }
+            let check_atoms = |kb: &mut crate::kb::Kb, list: &[String]| -> Result<(), LoadError> {
+                for t in list {
+                    kb.atom_key(t)
+                        .map_err(|m| bad(format!("fault `{label}`: `{t}`: {m}")))?;
+                }
+                Ok(())
+            };
+            if let Some(kb) = self.kb.as_mut() {
+                check_atoms(kb, spec.retract.as_deref().unwrap_or(&[]))?;
+                check_atoms(kb, &spec.add)?;
+                for o in [&spec.robot, &spec.part].into_iter().flatten() {
+                    if kb.object(o).is_none() {
+                        return Err(bad(format!(
+                            "fault `{label}`: `{o}` is not an object of the problem"
+                        )));
+                    }
+                }
+            } else if spec.retract.is_some() || !spec.add.is_empty() || spec.part.is_some() {
+                return Err(bad(format!(
+                    "fault `{label}` changes the KB, and no PDDL problem was given"
+                )));
+            }
+            if let Trigger::Step(k) = spec.trigger {
+                if k >= self.steps.len() {
+                    return Err(bad(format!(
+                        "fault `{label}`: the plan has no step {} ({} steps)",
+                        k + 1,
+                        self.steps.len()
+                    )));
+                }
+            }
+            self.faults.push(FaultRt {
+                spec: spec.clone(),
+                met_at: None,
+                until: None,
+                ended: false,
+                seen: 0,
+                pending_fail: false,
+                removed: Vec::new(),
+                added: Vec::new(),
+                shown: Vec::new(),
+                goal,
+            });
+        }
+        self.refresh_live();
+        Ok(())
+    }
+
+    fn refresh_live(&mut self) {
+        self.faults_live = self.faults.iter().any(|f| f.met_at.is_none() || !f.ended);
+    }
+
+    fn trigger(&mut self, f: usize) {
+        let tick = self.tick;
+        let spec = self.faults[f].spec.clone();
+        self.faults[f].met_at = Some(tick);
+        if self.opts.trace {
+            self.trace.push(TraceItem::Fault {
+                tick,
+                fault: f,
+                ended: false,
+            });
+        }
+        // KB changes.
+        if let Some(kb) = self.kb.as_mut() {
+            let mut retract: Vec<Key> = Vec::new();
+            match &spec.retract {
+                Some(list) => {
+                    for t in list {
+                        if let Ok(k) = kb.atom_key(t) {
+                            retract.push(k);
+                        }
+                    }
+                }
+                None if matches!(
+                    spec.kind,
+                    FaultKind::FaultyPart | FaultKind::InsufficientParts
+                ) =>
+                {
+                    if let Some(o) = spec.part.as_deref().and_then(|p| kb.object(p)) {
+                        retract = kb.facts_mentioning(o);
+                    }
+                }
+                None => {}
+            }
+            retract.retain(|k| kb.state.facts.contains(k));
+            let mut add: Vec<Key> = spec
+                .add
+                .iter()
+                .filter_map(|t| kb.atom_key(t).ok())
+                .collect();
+            add.retain(|k| !kb.state.facts.contains(k));
+            let shown: Vec<String> = retract.iter().chain(&add).map(|k| kb.show(k)).collect();
+            kb.apply_keys(add.clone(), retract.clone());
+            if let Some(g) = self.faults[f].goal {
+                kb.add_goal(g);
+            }
+            let rt = &mut self.faults[f];
+            rt.removed = retract;
+            rt.added = add;
+            rt.shown = shown;
+        }
+        let rt = &mut self.faults[f];
+        rt.pending_fail = spec.kind == FaultKind::FaultyGripper;
+        match spec.duration {
+            Some(d) if spec.kind != FaultKind::FaultyGripper => {
+                rt.until = Some(tick.saturating_add(d))
+            }
+            _ => {
+                // A one-off: nothing to undo; it stays "in effect" only for
+                // a gripper whose failure is still to happen.
+                rt.ended = !rt.pending_fail;
+            }
+        }
+        self.refresh_live();
+    }
+
+    fn end_fault(&mut self, f: usize) {
+        let rt = &mut self.faults[f];
+        rt.ended = true;
+        // A malfunction is repaired: what it retracted comes back.
+        if rt.spec.kind == FaultKind::RobotMalfunction {
+            let (add, del) = (
+                std::mem::take(&mut rt.removed),
+                std::mem::take(&mut rt.added),
+            );
+            if let Some(kb) = self.kb.as_mut() {
+                kb.apply_keys(add.clone(), del.clone());
+            }
+            let rt = &mut self.faults[f];
+            rt.removed = add;
+            rt.added = del;
+        }
+        if self.opts.trace {
+            self.trace.push(TraceItem::Fault {
+                tick: self.tick,
+                fault: f,
+                ended: true,
+            });
+        }
+        self.refresh_live();
+    }
+
+    pub(crate) fn faults_before_tick(&mut self) {
+        let tick = self.tick;
+        for f in 0..self.faults.len() {
+            let rt = &self.faults[f];
+            if rt.met_at.is_some() && !rt.ended && rt.until.is_some_and(|u| tick >= u) {
+                self.end_fault(f);
+            } else if rt.met_at.is_none() && rt.spec.trigger == Trigger::Tick(tick) {
+                self.trigger(f);
+            }
+        }
+    }
+
+    pub(crate) fn faults_on_step(&mut self, step: usize, _node: u32) {
+        for f in 0..self.faults.len() {
+            if self.faults[f].met_at.is_none() && self.faults[f].spec.trigger == Trigger::Step(step)
+            {
+                self.trigger(f);
+            }
+        }
+    }
+
+    fn in_effect(&self, f: usize) -> bool {
+        let rt = &self.faults[f];
+        rt.met_at.is_some() && !rt.ended
+    }
+
+    /// What faults do to an action leaf: `Some(status)` overrides its tick.
+    pub(crate) fn faults_on_action(&mut self, i: u32, a: u32, fresh: bool) -> Option<Status> {
+        if fresh {
+            for f in 0..self.faults.len() {
+                let fire = match &self.faults[f].spec.trigger {
+                    Trigger::Action { id, occurrence }
+                        if self.faults[f].met_at.is_none()
+                            && **id == *self.actions[a as usize].id =>
+                    {
+                        let occ = *occurrence;
+                        self.faults[f].seen += 1;
+                        self.faults[f].seen >= occ
+                    }
+                    _ => false,
+                };
+                if fire {
+                    self.trigger(f);
+                }
+            }
+        }
+        for f in 0..self.faults.len() {
+            if !self.in_effect(f) {
+                continue;
+            }
+            let spec = &self.faults[f].spec;
+            let Some(robot) = spec.robot.clone() else {
+                continue;
+            };
+            if !self.action_mentions(a, &robot) {
+                continue;
+            }
+            let label = spec.label();
+            match spec.kind {
+                FaultKind::RobotMalfunction => {
+                    let r =
+                        Reason::Fault(f, format!("robot `{robot}` malfunctions (fault `{label}`)"));
+                    self.note_failure(i, r.clone());
+                    self.record(i, &r);
+                    return Some(Status::Failure);
+                }
+                FaultKind::FaultyGripper if self.faults[f].pending_fail => {
+                    self.faults[f].pending_fail = false;
+                    self.faults[f].ended = true;
+                    self.refresh_live();
+                    let r = Reason::Fault(
+                        f,
+                        format!("the gripper of `{robot}` dropped the part (fault `{label}`)"),
+                    );
+                    self.note_failure(i, r.clone());
+                    self.record(i, &r);
+                    return Some(Status::Failure);
+                }
+                FaultKind::HumanTooClose | FaultKind::HighPriorityOrder
+                    if self.faults[f].until.is_some() =>
+                {
+                    // Paused: the action waits (or does not start yet).
+                    return Some(Status::Running);
+                }
+                _ => {}
+            }
+        }
+        None
+    }
+
+    /// During a sensor blackout: what conditions return.
+    pub(crate) fn blackout(&self) -> Option<Status> {
+        if !self.faults_live {
+            return None;
+        }
+        (0..self.faults.len())
+            .find(|&f| self.in_effect(f) && self.faults[f].spec.kind == FaultKind::SensorBlackout)
+            .map(|f| match self.faults[f].spec.blackout {
+                Blackout::Running => Status::Running,
+                Blackout::Failure => Status::Failure,
+            })
+    }
+
+    pub(crate) fn note_blackout(&mut self, i: u32) {
+        if let Some(f) = (0..self.faults.len())
+            .find(|&f| self.in_effect(f) && self.faults[f].spec.kind == FaultKind::SensorBlackout)
+        {
+            let label = self.faults[f].spec.label();
+            self.note_failure(
+                i,
+                Reason::Fault(
+                    f,
+                    format!("sensor blackout: the condition cannot be read (fault `{label}`)"),
+                ),
+            );
+        }
+    }
+
+    /// The faults a failure is attributed to: the one that caused it, those
+    /// in effect, and those whose facts the reason names.
+    pub(crate) fn faults_related(&self, r: &Reason, reason: &str) -> Vec<String> {
+        let mut out = Vec::new();
+        for (f, rt) in self.faults.iter().enumerate() {
+            if rt.met_at.is_none() {
+                continue;
+            }
+            let direct = matches!(r, Reason::Fault(g, _) if *g == f);
+            let named = rt.shown.iter().any(|s| reason.contains(s.as_str()))
+                || rt.spec.goal.as_deref().is_some_and(|g| reason.contains(g));
+            if direct || named || self.in_effect(f) {
+                out.push(rt.spec.label());
+            }
+        }
+        out
+    }
+
+    /// How each fault ended, given the run's result.
+    pub fn fault_outcomes(&self, success: bool) -> Vec<FaultOutcome> {
+        self.faults
+            .iter()
+            .map(|rt| {
+                let label = rt.spec.label();
+                let ended = if rt.met_at.is_none() {
+                    "not met".to_owned()
+                } else if success {
+                    "recovered".to_owned()
+                } else {
+                    match self
+                        .records
+                        .iter()
+                        .rev()
+                        .find(|r| r.faults.contains(&label))
+                    {
+                        Some(r) => format!("not recovered: {} failed: {}", r.node_name, r.reason),
+                        None => "not recovered".to_owned(),
+                    }
+                };
+                FaultOutcome {
+                    fault: label,
+                    kind: rt.spec.kind,
+                    met_at: rt.met_at,
+                    ended,
+                }
+            })
+            .collect()
+    }
+}

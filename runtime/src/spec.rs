@@ -1,0 +1,225 @@
+//! A loaded tree before compilation: what the JSON IR and the XML loader
+//! both produce, so the two run through one builder (and give one trace).
+
+use crate::error::LoadError;
+use btc_lang::diagnostic::codes;
+use btc_lang::ir::{LeafKind, Node, NodeModel, PortValue, StepInfo, TreeIr};
+use btc_lang::rules::ast::{ControlKind, DecoratorKind};
+
+/// What a node does. Thresholds and counts are BT.CPP's: `-1` means "all
+/// children" (Parallel) or "forever" (Retry, Repeat).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Kind {
+    Sequence,
+    ReactiveSequence,
+    SequenceWithMemory,
+    Fallback,
+    ReactiveFallback,
+    Parallel {
+        success: i32,
+        failure: i32,
+    },
+    Inverter,
+    ForceSuccess,
+    ForceFailure,
+    KeepRunningUntilFailure,
+    Retry(i32),
+    Repeat(i32),
+    Timeout(u64),
+    /// A call of a tree with port remapping.
+    SubTree {
+        id: String,
+        ports: Vec<(String, PortValue)>,
+        autoremap: bool,
+    },
+    /// The boundary of plan step `step` (0-based). Effects given here (the
+    /// XML `KbStep` attributes) take the place of the step table's.
+    Step {
+        step: usize,
+        start_effect: Option<String>,
+        end_effect: Option<String>,
+    },
+    /// A leaf: built in, a KB node, or a node of the models.
+    Leaf {
+        id: String,
+        kind: Option<LeafKind>,
+        ports: Vec<(String, PortValue)>,
+    },
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct SNode {
+    pub kind: Kind,
+    pub name: Option<String>,
+    pub children: Vec<SNode>,
+    /// Byte offset of the node in its source file, when it has one.
+    pub at: Option<usize>,
+}
+
+/// A whole document: its trees, the leaf models and the plan steps.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TreeDoc {
+    pub main: String,
+    pub trees: Vec<(String, SNode)>,
+    pub models: Vec<NodeModel>,
+    /// The compiled plan's steps (preconditions, effects) when known.
+    pub steps: Vec<StepInfo>,
+}
+
+impl TreeDoc {
+    pub fn tree(&self, id: &str) -> Option<&SNode> {
+        self.trees.iter().find(|(t, _)| t == id).map(|(_, n)| n)
+    }
+
+    pub fn model(&self, id: &str) -> Option<&NodeModel> {
+        self.models.iter().find(|m| m.id == id)
+    }
+
+    /// The document for btc's IR: the main tree and one tree per rule.
+    pub fn from_ir(ir: &TreeIr) -> TreeDoc {
+        let mut trees = vec![(ir.main_tree.clone(), from_node(&ir.root))];
+        trees.extend(ir.trees.iter().map(|t| (t.id.clone(), from_node(&t.root))));
+        TreeDoc {
+            main: ir.main_tree.clone(),
+            trees,
+            models: ir.nodes.clone(),
+            steps: ir.steps.clone(),
+        }
+    }
+
+    /// The document for a JSON text: btc's IR (`btc compile --emit json`).
+    pub fn from_json(text: &str) -> Result<(TreeDoc, TreeIr), LoadError> {
+        match serde_json::from_str::<TreeIr>(text) {
+            Ok(ir) => Ok((TreeDoc::from_ir(&ir), ir)),
+            Err(e) => {
+                let offset = line_col_offset(text, e.line(), e.column());
+                Err(LoadError::new(
+                    codes::X_TREE_SYNTAX,
+                    format!("this is not btc's JSON tree IR: {e}"),
+                )
+                .at(offset)
+                .hint("write it with `btc compile RULES --plan PLAN --emit json`"))
+            }
+        }
+    }
+}
+
+fn line_col_offset(text: &str, line: usize, col: usize) -> usize {
+    let start: usize = text
+        .split_inclusive('\n')
+        .take(line.saturating_sub(1))
+        .map(str::len)
+        .sum();
+    (start + col.saturating_sub(1)).min(text.len())
+}
+
+fn ports(ps: &[btc_lang::ir::Port]) -> Vec<(String, PortValue)> {
+    ps.iter()
+        .map(|p| (p.name.clone(), p.value.clone()))
+        .collect()
+}
+
+/// Converts an IR node; the IR nests at most a few dozen levels (its
+/// templates are written by hand), so recursion is fine here.
+pub fn from_node(n: &Node) -> SNode {
+    let (kind, name, children) = match n {
+        Node::Control {
+            control,
+            name,
+            children,
+        } => (
+            match control {
+                ControlKind::Sequence => Kind::Sequence,
+                ControlKind::ReactiveSequence => Kind::ReactiveSequence,
+                ControlKind::Fallback => Kind::Fallback,
+                ControlKind::ReactiveFallback => Kind::ReactiveFallback,
+                ControlKind::Parallel { success, failure } => Kind::Parallel {
+                    success: clamp(*success),
+                    failure: clamp(*failure),
+                },
+            },
+            name.clone(),
+            children.iter().map(from_node).collect(),
+        ),
+        Node::Decorator {
+            decorator,
+            name,
+            child,
+        } => (
+            match decorator {
+                DecoratorKind::Retry { times } => Kind::Retry(clamp(*times)),
+                DecoratorKind::Repeat { times } => Kind::Repeat(clamp(*times)),
+                DecoratorKind::Timeout { ms } => Kind::Timeout(*ms),
+                DecoratorKind::Inverter => Kind::Inverter,
+                DecoratorKind::ForceSuccess => Kind::ForceSuccess,
+                DecoratorKind::ForceFailure => Kind::ForceFailure,
+            },
+            name.clone(),
+            vec![from_node(child)],
+        ),
+        Node::Leaf {
+            leaf,
+            id,
+            name,
+            ports: ps,
+        } => (
+            Kind::Leaf {
+                id: id.clone(),
+                kind: Some(*leaf),
+                ports: ports(ps),
+            },
+            name.clone(),
+            Vec::new(),
+        ),
+        Node::SubTree { id, ports: ps } => (
+            Kind::SubTree {
+                id: id.clone(),
+                ports: ports(ps),
+                autoremap: false,
+            },
+            None,
+            Vec::new(),
+        ),
+        Node::Step { step, child } => (
+            Kind::Step {
+                step: *step,
+                start_effect: None,
+                end_effect: None,
+            },
+            None,
+            vec![from_node(child)],
+        ),
+    };
+    SNode {
+        kind,
+        name,
+        children,
+        at: None,
+    }
+}
+
+fn clamp(n: u32) -> i32 {
+    i32::try_from(n).unwrap_or(i32::MAX)
+}
+
+/// The name BT.CPP gives a node without a `name`: its registration ID.
+pub fn default_name(k: &Kind) -> &str {
+    match k {
+        Kind::Sequence => "Sequence",
+        Kind::ReactiveSequence => "ReactiveSequence",
+        Kind::SequenceWithMemory => "SequenceWithMemory",
+        Kind::Fallback => "Fallback",
+        Kind::ReactiveFallback => "ReactiveFallback",
+        Kind::Parallel { .. } => "Parallel",
+        Kind::Inverter => "Inverter",
+        Kind::ForceSuccess => "ForceSuccess",
+        Kind::ForceFailure => "ForceFailure",
+        Kind::KeepRunningUntilFailure => "KeepRunningUntilFailure",
+        Kind::Retry(_) => "RetryUntilSuccessful",
+        Kind::Repeat(_) => "Repeat",
+        Kind::Timeout(_) => "Timeout",
+        Kind::SubTree { id, .. } => id,
+        Kind::Step { .. } => "KbStep",
+        Kind::Leaf { id, .. } => id,
+    }
+}

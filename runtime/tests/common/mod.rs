@@ -1,0 +1,76 @@
+//! Shared by the integration tests: compile an example folder as `btc run`
+//! does, and build engines over its world.
+#![allow(dead_code)]
+
+use btc_lang::db::{self, CompileJob, Database};
+use btc_lang::ir::TreeIr;
+use btc_runtime::{Engine, JobWorld, Options, TreeDoc};
+use std::path::{Path, PathBuf};
+
+pub fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+pub fn fixture(name: &str) -> String {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures")
+        .join(name);
+    std::fs::read_to_string(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+}
+
+pub const EXAMPLES: &[&str] = &["ariac", "nist_kitting", "p3_assembler", "two_robots"];
+
+/// An example folder loaded and compiled (rules, its first plan, problem).
+pub struct Example {
+    pub db: Database,
+    pub job: CompileJob,
+    pub ir: TreeIr,
+}
+
+pub fn example(name: &str) -> Example {
+    let dir = root().join("examples").join(name);
+    let mut db = Database::new();
+    let mut rules = None;
+    let mut plan = None;
+    let mut names: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.is_file())
+        .collect();
+    names.sort();
+    for p in names {
+        let name = p.file_name().unwrap().to_string_lossy().into_owned();
+        let f = db.set_file(&db::normalize(&p), std::fs::read_to_string(&p).unwrap());
+        if name.starts_with("plan.") && plan.is_none() {
+            plan = Some(f);
+        }
+        if name == "rules.btrules" {
+            rules = Some(f);
+        }
+    }
+    let problem = db.file(&db::normalize(&dir.join("problem.pddl")));
+    let job = CompileJob::new(&db, rules.unwrap(), plan.unwrap(), problem, None);
+    let ir = db::compile(&db, job)
+        .as_ref()
+        .unwrap_or_else(|e| panic!("{name}: {e:#?}"))
+        .clone();
+    Example { db, job, ir }
+}
+
+impl Example {
+    pub fn world(&self) -> JobWorld<'_> {
+        JobWorld::of(&self.db, self.job).expect("the example has a domain and a problem")
+    }
+
+    /// An engine over the example's world for `doc`.
+    pub fn engine<'a>(&'a self, w: &'a JobWorld<'a>, doc: &TreeDoc, opts: Options) -> Engine<'a> {
+        Engine::build(doc, Some(w.kb()), opts).unwrap_or_else(|e| panic!("{e}"))
+    }
+}
+
+pub fn traced() -> Options {
+    Options {
+        trace: true,
+        ..Options::default()
+    }
+}

@@ -1,0 +1,277 @@
+//! `btc run`: compiles a plan (or loads a tree file) and executes it with
+//! the runtime against the problem's simulated world, with injected faults.
+
+use crate::{files, report, rules_cmd, Format};
+use btc_lang::db;
+use btc_lang::diagnostic::{has_errors, Diagnostic};
+use btc_lang::pipeline;
+use btc_lang::source::{FileId, Sources, Span};
+use btc_runtime::{Controller, Engine, Kb, LoadError, Options, Scenario, Summary, TreeDoc};
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Duration;
+
+pub struct RunArgs {
+    pub rules: Option<PathBuf>,
+    pub tree: Option<PathBuf>,
+    pub plan: Option<PathBuf>,
+    pub problem: Option<PathBuf>,
+    pub domain: Option<PathBuf>,
+    pub faults: Option<PathBuf>,
+    pub trace: Option<PathBuf>,
+    pub ticks_per_action: u32,
+    pub tick_ms: u64,
+    pub max_ticks: u64,
+    pub controller: bool,
+    pub format: Format,
+}
+
+/// A runtime error as a diagnostic on the file it is about; the span covers
+/// the word (an XML tag's name) at its offset.
+fn diagnostic(e: &LoadError, file: FileId, sources: &Sources) -> Diagnostic {
+    let text = sources.text(file);
+    let at = e.offset.unwrap_or(0).min(text.len());
+    let end = match e.offset {
+        Some(_) => text[at..]
+            .char_indices()
+            .skip(1)
+            .find(|(_, c)| c.is_whitespace() || matches!(c, '>' | '/' | '='))
+            .map_or(text.len(), |(k, _)| at + k),
+        None => at,
+    };
+    let mut d = Diagnostic::error(e.code, Span::new(file, at, end), e.message.clone());
+    if let Some(h) = &e.hint {
+        d = d.with_hint(h.clone());
+    }
+    d
+}
+
+fn fail(diags: &[Diagnostic], sources: &Sources, format: Format) -> anyhow::Result<ExitCode> {
+    let json = report::diagnostics(diags, sources, format);
+    if format == Format::Json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&serde_json::json!({ "ok": false, "diagnostics": json }))?
+        );
+    }
+    Ok(ExitCode::from(1))
+}
+
+pub fn run(a: &RunArgs) -> anyhow::Result<ExitCode> {
+    match (&a.rules, &a.tree) {
+        (Some(rules), None) => {
+            let plan = a.plan.as_deref().ok_or_else(|| {
+                anyhow::anyhow!(
+                    "`btc run RULES` needs `--plan PLAN` (or run a tree file with `--tree`)"
+                )
+            })?;
+            run_rules(a, rules, plan)
+        }
+        (None, Some(tree)) => run_tree(a, tree),
+        _ => {
+            anyhow::bail!("give either a rules file (with `--plan`) or `--tree TREE.xml|TREE.json`")
+        }
+    }
+}
+
+fn run_rules(a: &RunArgs, rules: &Path, plan: &Path) -> anyhow::Result<ExitCode> {
+    let mut diags = Vec::new();
+    let (database, job) = rules_cmd::load_job(
+        rules,
+        plan,
+        a.problem.as_deref(),
+        a.domain.as_deref(),
+        &mut diags,
+    )?;
+    let ir = if has_errors(&diags) {
+        None
+    } else {
+        match db::compile(&database, job) {
+            Ok(ir) => Some(ir),
+            Err(errs) => {
+                diags.extend(
+                    errs.iter()
+                        .filter(|e| !diags.contains(e))
+                        .cloned()
+                        .collect::<Vec<_>>(),
+                );
+                None
+            }
+        }
+    };
+    let mut sources = database.sources();
+    let (Some(ir), Some(world)) = (ir, btc_runtime::JobWorld::of(&database, job)) else {
+        return fail(&diags, &sources, a.format);
+    };
+    if a.format == Format::Text {
+        report::diagnostics(&diags, &sources, a.format);
+    }
+    let doc = TreeDoc::from_ir(ir);
+    let anchor = db::file_id(&database, job.plan(&database));
+    execute(a, &doc, Some(world.kb()), &mut sources, anchor)
+}
+
+fn run_tree(a: &RunArgs, tree: &Path) -> anyhow::Result<ExitCode> {
+    let mut sources = Sources::new();
+    let mut diags = Vec::new();
+    let file = files::load(&mut sources, tree, &mut diags)?;
+    if has_errors(&diags) {
+        return fail(&diags, &sources, a.format);
+    }
+    let (doc, ir) = match btc_runtime::load_tree(sources.text(file)) {
+        Ok(x) => x,
+        Err(e) => return fail(&[diagnostic(&e, file, &sources)], &sources, a.format),
+    };
+    // The world: `--problem` (and `--domain`), or the files a JSON IR names.
+    let named = |p: Option<&String>| p.map(PathBuf::from).filter(|p| p.is_file());
+    let problem_path = a
+        .problem
+        .clone()
+        .or_else(|| named(ir.as_ref().map(|i| &i.problem)));
+    let Some(problem_path) = problem_path else {
+        return execute(a, &doc, None, &mut sources, file);
+    };
+    let domain_path = a
+        .domain
+        .clone()
+        .or_else(|| named(ir.as_ref().map(|i| &i.domain)))
+        .or_else(|| Some(problem_path.with_file_name("domain.pddl")).filter(|p| p.is_file()))
+        .ok_or_else(|| {
+            anyhow::anyhow!(
+                "no domain for `{}`: pass `--domain DOMAIN`",
+                problem_path.display()
+            )
+        })?;
+    let dfile = files::load(&mut sources, &domain_path, &mut diags)?;
+    let pfile = files::load(&mut sources, &problem_path, &mut diags)?;
+    let du = pipeline::domain_unit(&sources, dfile);
+    let pu = pipeline::problem_unit(&sources, pfile, &du);
+    diags.extend(du.diagnostics.iter().cloned());
+    diags.extend(pu.diagnostics.iter().cloned());
+    let (Some(domain), Some(problem)) = (&du.domain, &pu.problem) else {
+        return fail(&diags, &sources, a.format);
+    };
+    if has_errors(&diags) {
+        return fail(&diags, &sources, a.format);
+    }
+    let kb = Kb::new(domain, &du.index, problem, &pu.index);
+    execute(a, &doc, Some(kb), &mut sources, file)
+}
+
+fn execute(
+    a: &RunArgs,
+    doc: &TreeDoc,
+    kb: Option<Kb<'_>>,
+    sources: &mut Sources,
+    tree_file: FileId,
+) -> anyhow::Result<ExitCode> {
+    let opts = Options {
+        ticks_per_action: a.ticks_per_action,
+        ms_per_tick: if a.tick_ms > 0 { a.tick_ms } else { 10 },
+        trace: a.trace.is_some(),
+    };
+    let mut engine = match Engine::build(doc, kb, opts) {
+        Ok(e) => e,
+        Err(e) => return fail(&[diagnostic(&e, tree_file, sources)], sources, a.format),
+    };
+    if let Some(path) = &a.faults {
+        let mut diags = Vec::new();
+        let f = files::load(sources, path, &mut diags)?;
+        if has_errors(&diags) {
+            return fail(&diags, sources, a.format);
+        }
+        let added = Scenario::parse(sources.text(f)).and_then(|s| engine.add_faults(&s));
+        if let Err(e) = added {
+            return fail(&[diagnostic(&e, f, sources)], sources, a.format);
+        }
+    }
+    if a.controller {
+        engine.attach_controller(Controller::start(16, Duration::ZERO));
+    }
+    let bar = (a.format == Format::Text && std::io::stderr().is_terminal()).then(|| {
+        let pb = indicatif::ProgressBar::new(engine.steps_total() as u64);
+        pb.set_style(
+            indicatif::ProgressStyle::with_template("{spinner} {pos}/{len} steps  {msg}")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        pb
+    });
+    let pace = Duration::from_millis(a.tick_ms);
+    let status = engine.run(a.max_ticks, |e| {
+        if let Some(pb) = &bar {
+            pb.set_position(e.steps_done() as u64);
+            pb.set_message(format!("tick {}", e.tick));
+        }
+        if !pace.is_zero() {
+            std::thread::sleep(pace);
+        }
+    });
+    if let Some(pb) = bar {
+        pb.finish_and_clear();
+    }
+    let commands = engine.take_controller().map(Controller::shutdown);
+    if let Some(path) = &a.trace {
+        files::write_atomically(path, &engine.trace_jsonl())?;
+    }
+    let summary = engine.summary(status);
+    match a.format {
+        Format::Json => {
+            let mut v = serde_json::to_value(&summary)?;
+            if let (Some(o), Some(c)) = (v.as_object_mut(), &commands) {
+                o.insert("commands".into(), serde_json::to_value(c)?);
+            }
+            println!("{}", serde_json::to_string_pretty(&v)?);
+        }
+        Format::Text => print_summary(&summary, commands.as_ref().map(Vec::len)),
+    }
+    Ok(if summary.success() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
+}
+
+fn print_summary(s: &Summary, commands: Option<usize>) {
+    let yes = |b: bool| if b { "yes" } else { "no" };
+    println!(
+        "{} after {}; {} of {} plan steps done; goal reached: {}",
+        s.status.name(),
+        report::plural(s.ticks as usize, "tick"),
+        s.steps_done,
+        s.steps_total,
+        match s.goal_reached {
+            Some(g) => yes(g),
+            None => "no goal (no problem given)",
+        }
+    );
+    if let Some(why) = &s.goal_failure {
+        println!("  goal: {why}");
+    }
+    if let Some(n) = commands {
+        println!("controller: {} executed", report::plural(n, "command"));
+    }
+    for f in &s.faults {
+        let met = match f.met_at {
+            Some(t) => format!("met at tick {t}"),
+            None => "not met".to_owned(),
+        };
+        println!("fault {} ({}): {met}; {}", f.fault, f.kind.name(), f.ended);
+    }
+    for r in &s.records {
+        let step = r
+            .action
+            .as_deref()
+            .map(|a| format!(" in {a}"))
+            .unwrap_or_default();
+        let faults = if r.faults.is_empty() {
+            String::new()
+        } else {
+            format!(" [fault: {}]", r.faults.join(", "))
+        };
+        println!(
+            "record: tick {}: `{}` ({}){step} failed: {}{faults}",
+            r.tick, r.node_name, r.node_id, r.reason
+        );
+    }
+}

@@ -1,0 +1,283 @@
+//! `btc run` as a user meets it: exit codes, the summary, the trace file,
+//! tree files, fault scenarios and the controller.
+
+use std::process::{Command, Output};
+
+fn btc(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_btc"))
+        .args(args)
+        .env("NO_COLOR", "1")
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap()
+}
+
+fn plan_of(example: &str) -> String {
+    let dir = format!("{}/examples/{example}", env!("CARGO_MANIFEST_DIR"));
+    let mut plans: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with("plan."))
+        .collect();
+    plans.sort();
+    format!("examples/{example}/{}", plans[0])
+}
+
+fn summary(out: &Output) -> serde_json::Value {
+    serde_json::from_slice(&out.stdout)
+        .unwrap_or_else(|e| panic!("{e}: {}", String::from_utf8_lossy(&out.stdout)))
+}
+
+#[test]
+fn every_example_runs_to_its_goal_and_exits_0() {
+    for ex in ["ariac", "nist_kitting", "p3_assembler", "two_robots"] {
+        let rules = format!("examples/{ex}/rules.btrules");
+        let plan = plan_of(ex);
+        let out = btc(&["run", &rules, "--plan", &plan, "--format", "json"]);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{ex}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let s = summary(&out);
+        assert_eq!(s["status"], "SUCCESS", "{ex}");
+        assert_eq!(s["goal_reached"], true, "{ex}");
+        assert_eq!(s["steps_done"], s["steps_total"], "{ex}");
+    }
+}
+
+#[test]
+fn the_text_summary_names_ticks_steps_and_the_goal() {
+    let out = btc(&[
+        "run",
+        "examples/ariac/rules.btrules",
+        "--plan",
+        "examples/ariac/plan.txt",
+        "--ticks-per-action",
+        "3",
+    ]);
+    assert_eq!(out.status.code(), Some(0));
+    let text = String::from_utf8_lossy(&out.stdout);
+    // Four steps of one action each, three ticks per action plus the start.
+    assert_eq!(
+        text.lines().next().unwrap(),
+        "SUCCESS after 13 ticks; 4 of 4 plan steps done; goal reached: yes"
+    );
+}
+
+#[test]
+fn a_fault_that_is_not_recovered_exits_1_with_its_record() {
+    let out = btc(&[
+        "run",
+        "examples/ariac/rules.btrules",
+        "--plan",
+        "examples/ariac/plan.txt",
+        "--faults",
+        "examples/ariac/faults/faulty_part.toml",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("fault faulty_part (faulty_part): met at tick 2; not recovered"),
+        "{text}"
+    );
+    assert!(
+        text.contains("`(on battery_red bin1)` is false [fault: faulty_part]"),
+        "{text}"
+    );
+}
+
+#[test]
+fn a_recovered_fault_exits_0() {
+    let out = btc(&[
+        "run",
+        "examples/ariac/rules.btrules",
+        "--plan",
+        "examples/ariac/plan.txt",
+        "--faults",
+        "examples/ariac/faults/human_too_close.toml",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(out.status.code(), Some(0));
+    let s = summary(&out);
+    assert_eq!(s["faults"][0]["ended"], "recovered");
+}
+
+#[test]
+fn the_trace_is_json_lines_of_status_changes_written_atomically() {
+    let dir = tempfile::tempdir().unwrap();
+    let trace = dir.path().join("trace.jsonl");
+    let out = btc(&[
+        "run",
+        "examples/ariac/rules.btrules",
+        "--plan",
+        "examples/ariac/plan.txt",
+        "--trace",
+        trace.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0));
+    let text = std::fs::read_to_string(&trace).unwrap();
+    let lines: Vec<serde_json::Value> = text
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert!(lines.len() > 20);
+    assert_eq!(lines[0]["node"], 0);
+    assert_eq!(lines[0]["from"], "IDLE");
+    assert_eq!(lines[0]["to"], "RUNNING");
+    let last = lines.iter().rev().find(|l| l["node"] == 0).unwrap();
+    assert_eq!(last["to"], "SUCCESS");
+    assert_eq!(
+        lines
+            .iter()
+            .filter(|l| l["event"] == "step_finished")
+            .count(),
+        4
+    );
+    // Only the trace is left in the folder: no temporary file.
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+}
+
+#[test]
+fn an_emitted_tree_runs_with_tree_and_the_problem() {
+    let dir = tempfile::tempdir().unwrap();
+    for (fmt, ext) in [("btcpp", "xml"), ("json", "json")] {
+        let tree = dir.path().join(format!("tree.{ext}"));
+        let out = btc(&[
+            "compile",
+            "examples/ariac/rules.btrules",
+            "--plan",
+            "examples/ariac/plan.txt",
+            "--emit",
+            fmt,
+            "-o",
+            tree.to_str().unwrap(),
+        ]);
+        assert_eq!(out.status.code(), Some(0));
+        let out = btc(&[
+            "run",
+            "--tree",
+            tree.to_str().unwrap(),
+            "--problem",
+            "examples/ariac/problem.pddl",
+            "--format",
+            "json",
+        ]);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{fmt}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert_eq!(summary(&out)["goal_reached"], true);
+    }
+}
+
+#[test]
+fn a_kb_tree_without_a_problem_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let tree = dir.path().join("tree.xml");
+    let out = btc(&[
+        "compile",
+        "examples/ariac/rules.btrules",
+        "--plan",
+        "examples/ariac/plan.txt",
+        "--emit",
+        "btcpp",
+        "-o",
+        tree.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0));
+    let out = btc(&["run", "--tree", tree.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("[X005]"));
+}
+
+#[test]
+fn the_controller_executes_each_command_once() {
+    let out = btc(&[
+        "run",
+        "examples/nist_kitting/rules.btrules",
+        "--plan",
+        &plan_of("nist_kitting"),
+        "--controller",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let s = summary(&out);
+    let cmds = s["commands"].as_array().unwrap();
+    assert!(cmds.len() > 10);
+    for (k, c) in cmds.iter().enumerate() {
+        assert_eq!(c["seq"], k as u64 + 1);
+    }
+}
+
+#[test]
+fn usage_and_io_errors_exit_2() {
+    let out = btc(&["run", "--tree", "no/such/tree.xml"]);
+    assert_eq!(out.status.code(), Some(2));
+    let out = btc(&["run", "examples/ariac/rules.btrules"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--plan"));
+    let out = btc(&["run"]);
+    assert_eq!(out.status.code(), Some(2));
+}
+
+#[test]
+fn a_tree_that_never_finishes_is_halted_after_max_ticks() {
+    let out = btc(&[
+        "run",
+        "--tree",
+        "tests/fixtures/run/forever.xml",
+        "--max-ticks",
+        "50",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let s = summary(&out);
+    assert_eq!(s["status"], "RUNNING");
+    assert_eq!(s["ticks"], 50);
+    let reason = s["records"][0]["reason"].as_str().unwrap();
+    assert!(reason.contains("still running after 50 ticks"), "{reason}");
+}
+
+#[test]
+fn an_xml_tree_checks_step_preconditions_from_the_domain() {
+    let dir = tempfile::tempdir().unwrap();
+    let tree = dir.path().join("tree.xml");
+    let out = btc(&[
+        "compile",
+        "examples/ariac/rules.btrules",
+        "--plan",
+        "examples/ariac/plan.txt",
+        "--emit",
+        "btcpp",
+        "-o",
+        tree.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0));
+    let out = btc(&[
+        "run",
+        "--tree",
+        tree.to_str().unwrap(),
+        "--problem",
+        "examples/ariac/problem.pddl",
+        "--faults",
+        "examples/ariac/faults/insufficient_parts.toml",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("its step's precondition does not hold: `(on battery_red bin1)` is false"),
+        "{text}"
+    );
+}
