@@ -32,7 +32,10 @@ fn neovim_sees_a_diagnostic_and_its_fix() {
         .unwrap();
     let col = line.find("Grsp").unwrap();
     let lines: Vec<&str> = report.lines().collect();
-    assert_eq!(lines[0], format!("R007 {line_no}:{col}-{line_no}:{}", col + 4));
+    assert_eq!(
+        lines[0],
+        format!("R007 {line_no}:{col}-{line_no}:{}", col + 4)
+    );
     assert_eq!(
         lines[1],
         "message no node or tree is called `Grsp` | hint: did you mean `Grasp`?"
