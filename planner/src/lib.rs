@@ -1,0 +1,170 @@
+//! The btc planner: grounds a PDDL problem of the `btc-lang` model (with
+//! reachability pruning) and searches it with greedy best-first search or
+//! A* under h_FF, h_add, h_max or the blind heuristic.
+//!
+//! [`plan`] plans from a problem's `:init`; [`plan_from`] from any state of
+//! the problem's objects (a runtime's knowledge base) to any goal, which is
+//! what replanning needs. Nothing here prints.
+
+pub mod ground;
+pub mod heuristic;
+pub mod lifted;
+pub mod search;
+pub mod task;
+
+pub use ground::GroundStats;
+pub use heuristic::Heuristic;
+pub use search::{Algorithm, Options, SearchStats};
+
+use btc_lang::diagnostic::{codes, Diagnostic};
+use btc_lang::pddl::ast::{Domain, Formula, Problem};
+use btc_lang::pddl::check::{DomainIndex, ProblemIndex};
+use btc_lang::state::{State, World};
+use std::time::{Duration, Instant};
+
+/// One step of a plan: an action of the domain and its arguments (object
+/// ids of the problem index).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Step {
+    pub action: usize,
+    pub args: Vec<u32>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Plan {
+    pub steps: Vec<Step>,
+    /// The sum of the step costs (`total-cost` increases, or 1 per step
+    /// when the domain has no `total-cost`).
+    pub cost: u64,
+    /// `total-cost` before the first step.
+    pub base_cost: f64,
+    /// Whether every action costs 1.
+    pub unit_cost: bool,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Outcome {
+    Plan(Plan),
+    /// No plan exists (the search space is exhausted).
+    Unsolvable,
+    /// The time limit stopped the search.
+    Timeout,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Report {
+    pub outcome: Outcome,
+    pub ground: GroundStats,
+    pub ground_time: Duration,
+    pub search: SearchStats,
+}
+
+/// Plans from the problem's initial state to its goal.
+pub fn plan(
+    domain: &Domain,
+    dix: &DomainIndex,
+    problem: &Problem,
+    pix: &ProblemIndex,
+    opts: &Options,
+) -> Result<Report, Vec<Diagnostic>> {
+    let world = World::new(domain, dix, pix);
+    let init = world.initial_state(problem);
+    plan_from(domain, dix, pix, &init, problem.goal.as_ref(), opts)
+}
+
+/// Plans from `initial` (facts and numeric values over the problem's
+/// objects; derived atoms are recomputed) to `goal` (`None`: already
+/// reached).
+pub fn plan_from(
+    domain: &Domain,
+    dix: &DomainIndex,
+    pix: &ProblemIndex,
+    initial: &State,
+    goal: Option<&Formula>,
+    opts: &Options,
+) -> Result<Report, Vec<Diagnostic>> {
+    let t0 = Instant::now();
+    let (task, ground) = ground::ground(domain, dix, pix, initial, goal)?;
+    let ground_time = t0.elapsed();
+    let mut opts = *opts;
+    if let Some(t) = opts.timeout {
+        opts.timeout = Some(t.saturating_sub(ground_time));
+    }
+    let mut s = search::Search::new(&task, opts);
+    let result = s.run();
+    let outcome = match result {
+        search::SearchResult::Plan(ops, cost) => Outcome::Plan(Plan {
+            steps: ops
+                .iter()
+                .map(|&o| {
+                    let op = &task.operators[o as usize];
+                    Step {
+                        action: op.action,
+                        args: op.args.clone(),
+                    }
+                })
+                .collect(),
+            cost,
+            base_cost: task.base_cost,
+            unit_cost: task.unit_cost,
+        }),
+        search::SearchResult::Unsolvable => Outcome::Unsolvable,
+        search::SearchResult::Timeout => Outcome::Timeout,
+    };
+    Ok(Report {
+        outcome,
+        ground,
+        ground_time,
+        search: s.stats,
+    })
+}
+
+/// The plan in Fast Downward's `sas_plan` format: one `(action args)` per
+/// line, then `; cost = N (unit cost|general cost)`.
+pub fn to_sas_plan(domain: &Domain, pix: &ProblemIndex, plan: &Plan) -> String {
+    let mut out = String::new();
+    for s in &plan.steps {
+        out.push('(');
+        out.push_str(&domain.actions[s.action].name.name);
+        for &a in &s.args {
+            out.push(' ');
+            out.push_str(&pix.object_names[a as usize]);
+        }
+        out.push_str(")\n");
+    }
+    let total = plan.base_cost + plan.cost as f64;
+    out.push_str(&format!(
+        "; cost = {} ({})\n",
+        total,
+        if plan.unit_cost {
+            "unit cost"
+        } else {
+            "general cost"
+        }
+    ));
+    out
+}
+
+/// The diagnostic for a goal no plan reaches.
+pub fn unsolvable(problem: &Problem) -> Diagnostic {
+    let span = problem.goal.as_ref().map_or(problem.span, Formula::span);
+    Diagnostic::error(
+        codes::PLAN_UNSOLVABLE,
+        span,
+        "no plan reaches this goal from the initial state",
+    )
+    .with_hint("every reachable state was searched; check the goal and the `:init` facts")
+}
+
+/// The diagnostic for a search stopped by its time limit.
+pub fn timeout(problem: &Problem, limit: Duration) -> Diagnostic {
+    Diagnostic::error(
+        codes::PLAN_TIMEOUT,
+        problem.name.span,
+        format!(
+            "no plan found within the time limit of {} s",
+            limit.as_secs_f64()
+        ),
+    )
+    .with_hint("raise `--timeout`, or try `--search gbfs --heuristic ff`")
+}
