@@ -241,44 +241,37 @@ impl Grounder<'_> {
         leaf: &mut dyn FnMut(&[u32]),
     ) {
         if let Some(((pred, args), rest)) = atoms.split_first() {
-            'tuples: for t in &self.by_pred[*pred as usize] {
-                let mut bound = Vec::new();
+            let mut bound = [0usize; MAX_ARITY];
+            for t in &self.by_pred[*pred as usize] {
+                let mut nb = 0;
+                let mut ok = true;
                 for (i, a) in args.iter().enumerate() {
                     let o = t[i + 1];
                     match *a {
-                        LTerm::Obj(c) if c != o => {
-                            for s in bound {
-                                env[s] = None;
-                            }
-                            continue 'tuples;
-                        }
-                        LTerm::Obj(_) => {}
+                        LTerm::Obj(c) => ok = c == o,
                         LTerm::Slot(s) => {
                             let s = s as usize;
                             match env[s] {
-                                Some(v) if v != o => {
-                                    for s in bound {
-                                        env[s] = None;
-                                    }
-                                    continue 'tuples;
-                                }
-                                Some(_) => {}
+                                Some(v) => ok = v == o,
                                 None => {
-                                    if !allowed[s].get(o as usize).copied().unwrap_or(false) {
-                                        for s in bound {
-                                            env[s] = None;
-                                        }
-                                        continue 'tuples;
+                                    ok = allowed[s].get(o as usize).copied().unwrap_or(false);
+                                    if ok {
+                                        env[s] = Some(o);
+                                        bound[nb] = s;
+                                        nb += 1;
                                     }
-                                    env[s] = Some(o);
-                                    bound.push(s);
                                 }
                             }
                         }
                     }
+                    if !ok {
+                        break;
+                    }
                 }
-                self.join(rest, params, allowed, env, leaf);
-                for s in bound {
+                if ok {
+                    self.join(rest, params, allowed, env, leaf);
+                }
+                for &s in &bound[..nb] {
                     env[s] = None;
                 }
             }
@@ -461,6 +454,37 @@ impl Grounder<'_> {
     }
 }
 
+/// Orders a join: each next atom shares the most variables with those
+/// before it (so no cross products are built when a chain exists), with
+/// fewer new variables breaking ties.
+fn join_order(mut atoms: Vec<(u32, Vec<LTerm>)>, slots: usize) -> Vec<(u32, Vec<LTerm>)> {
+    let mut bound = vec![false; slots];
+    let mut out = Vec::with_capacity(atoms.len());
+    while !atoms.is_empty() {
+        let score = |(_, args): &(u32, Vec<LTerm>)| {
+            let known = args
+                .iter()
+                .filter(|a| match a {
+                    LTerm::Obj(_) => true,
+                    LTerm::Slot(s) => bound[*s as usize],
+                })
+                .count();
+            (known, usize::MAX - (args.len() - known))
+        };
+        let best = (0..atoms.len())
+            .max_by_key(|&i| (score(&atoms[i]), usize::MAX - i))
+            .unwrap_or(0);
+        let a = atoms.remove(best);
+        for t in &a.1 {
+            if let LTerm::Slot(s) = t {
+                bound[*s as usize] = true;
+            }
+        }
+        out.push(a);
+    }
+    out
+}
+
 fn num_value(e: &LNum, env: &[u32], state: &State) -> Option<f64> {
     Some(match e {
         LNum::Const(v) => *v,
@@ -588,7 +612,14 @@ pub fn ground(
         .map(|s| {
             let mut atoms = Vec::new();
             necessary_atoms(&s.pre_start, &mut atoms);
-            atoms.retain(|(_, args)| args.len() <= MAX_ARITY);
+            atoms.retain(|(_, args)| {
+                args.len() <= MAX_ARITY
+                    && args.iter().all(|a| {
+                        matches!(a, LTerm::Obj(_))
+                            || matches!(a, LTerm::Slot(x) if (*x as usize) < s.params.len())
+                    })
+            });
+            let atoms = join_order(atoms, s.slots.max(s.params.len()));
             let allowed: Vec<Vec<bool>> = s
                 .params
                 .iter()

@@ -1,0 +1,154 @@
+//! The planner on the IPC corpus in `../shared/corpus/` (walked, not
+//! listed): greedy search finds plans that the front end's validator
+//! accepts, and A* with admissible heuristics finds the optimal costs the
+//! corpus records. The benchmark (`cargo bench -p btc-planner`) runs the
+//! whole corpus; these tests skip the few problems that take seconds.
+
+mod common;
+
+use btc_planner::{Algorithm, Heuristic, Options};
+use common::*;
+
+/// Problems whose greedy search takes over a second in a release build;
+/// the benchmark covers them.
+const SLOW_GBFS: &[&str] = &["tidybot/p02"];
+
+fn corpus_problems() -> Vec<(String, String)> {
+    let mut out = Vec::new();
+    let mut dirs: Vec<_> = std::fs::read_dir(corpus_dir())
+        .expect("corpus directory (set BTC_CORPUS to override)")
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.is_dir())
+        .collect();
+    dirs.sort();
+    for dir in dirs {
+        let domain = dir.file_name().unwrap().to_string_lossy().into_owned();
+        let mut problems: Vec<String> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|n| n.ends_with(".pddl") && !n.contains("domain"))
+            .map(|n| n.trim_end_matches(".pddl").to_owned())
+            .filter(|stem| dir.join(format!("{stem}.plan")).exists())
+            .collect();
+        problems.sort();
+        out.extend(problems.into_iter().map(|p| (domain.clone(), p)));
+    }
+    assert!(out.len() >= 40, "expected the 40 corpus problems");
+    out
+}
+
+#[test]
+fn greedy_search_solves_the_corpus_with_valid_plans() {
+    let mut solved = 0;
+    for (domain, problem) in corpus_problems() {
+        if SLOW_GBFS.contains(&format!("{domain}/{problem}").as_str()) {
+            continue;
+        }
+        let (d, p) = corpus_case(&domain, &problem);
+        let mut l = load(&d, &p);
+        let (_, cost, report) = l.solve_and_validate(&Options::default());
+        assert!(cost >= 0.0);
+        assert!(report.search.expanded > 0 || report.ground.operators > 0);
+        solved += 1;
+    }
+    assert!(solved >= 39, "solved {solved}");
+}
+
+/// Problems A* with h_max solves within a second or so; the rest are in
+/// the benchmark.
+const ASTAR_SUBSET: &[(&str, &str)] = &[
+    ("blocks", "p01"),
+    ("blocks", "p02"),
+    ("gripper", "p01"),
+    ("logistics", "p01"),
+    ("depot", "p01"),
+    ("rovers", "p01"),
+    ("rovers", "p02"),
+    ("visitall", "p02"),
+    ("storage", "p01"),
+    ("storage", "p02"),
+    ("elevators", "p02"),
+    ("transport", "p01"),
+    ("transport", "p02"),
+    ("hiking", "p01"),
+    ("miconic-simpleadl", "p01"),
+    ("miconic-simpleadl", "p02"),
+    ("psr-middle", "p01"),
+    ("psr-middle", "p02"),
+    ("openstacks-adl", "p01"),
+    ("tidybot", "p01"),
+];
+
+#[test]
+fn astar_with_an_admissible_heuristic_finds_the_recorded_optimal_costs() {
+    let optimal = optimal_domains();
+    let opts = Options {
+        algorithm: Algorithm::Astar,
+        heuristic: Heuristic::Max,
+        timeout: None,
+    };
+    let mut compared = 0;
+    for &(domain, problem) in ASTAR_SUBSET {
+        let (_, o1, o2) = optimal
+            .iter()
+            .find(|(d, _, _)| d == domain)
+            .unwrap_or_else(|| panic!("{domain} is not in the corpus README"));
+        let is_optimal = if problem == "p01" { *o1 } else { *o2 };
+        let (d, p) = corpus_case(domain, problem);
+        let mut l = load(&d, &p);
+        let (_, cost, _) = l.solve_and_validate(&opts);
+        let reference = stated_cost(&corpus_dir().join(domain).join(format!("{problem}.plan")));
+        if is_optimal {
+            assert_eq!(
+                cost, reference,
+                "{domain}/{problem}: A* cost vs optimal reference"
+            );
+            compared += 1;
+        } else {
+            assert!(
+                cost <= reference,
+                "{domain}/{problem}: A* worse than a satisficing plan"
+            );
+        }
+    }
+    assert!(compared >= 15, "compared {compared}");
+}
+
+#[test]
+fn astar_with_h_max_and_with_blind_search_agree_on_small_problems() {
+    for (domain, problem) in [
+        ("gripper", "p01"),
+        ("blocks", "p01"),
+        ("miconic-simpleadl", "p01"),
+        ("psr-middle", "p02"),
+        ("visitall", "p02"),
+        ("storage", "p02"),
+        ("transport", "p01"),
+        ("openstacks-adl", "p01"),
+    ] {
+        let (d, p) = corpus_case(domain, problem);
+        let mut l = load(&d, &p);
+        let costs: Vec<f64> = [Heuristic::Max, Heuristic::Blind]
+            .into_iter()
+            .map(|heuristic| {
+                let opts = Options {
+                    algorithm: Algorithm::Astar,
+                    heuristic,
+                    timeout: None,
+                };
+                l.solve_and_validate(&opts).1
+            })
+            .collect();
+        assert_eq!(costs[0], costs[1], "{domain}/{problem}");
+        // h_add and h_FF are not admissible, but their A* plans are valid
+        // and no cheaper than the optimum.
+        for heuristic in [Heuristic::Add, Heuristic::Ff] {
+            let opts = Options {
+                algorithm: Algorithm::Astar,
+                heuristic,
+                timeout: None,
+            };
+            assert!(l.solve_and_validate(&opts).1 >= costs[0]);
+        }
+    }
+}
