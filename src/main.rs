@@ -121,6 +121,9 @@ enum Command {
         /// Give up after this many seconds.
         #[arg(long, value_name = "S")]
         timeout: Option<f64>,
+        /// Do not print search statistics on stderr.
+        #[arg(short, long)]
+        quiet: bool,
         #[arg(long, value_enum, default_value_t)]
         format: Format,
     },
@@ -245,6 +248,7 @@ fn main() -> ExitCode {
             search,
             heuristic,
             timeout,
+            quiet,
             format,
         } => plan_options(search, heuristic, timeout).and_then(|options| {
             plan_cmd::run(&plan_cmd::PlanArgs {
@@ -252,6 +256,7 @@ fn main() -> ExitCode {
                 problem: &problem,
                 output: output.as_deref(),
                 options,
+                quiet,
                 format,
             })
         }),

@@ -14,6 +14,7 @@ pub struct PlanArgs<'a> {
     pub problem: &'a Path,
     pub output: Option<&'a Path>,
     pub options: Options,
+    pub quiet: bool,
     pub format: Format,
 }
 
@@ -71,7 +72,7 @@ pub fn run(args: &PlanArgs) -> anyhow::Result<ExitCode> {
             args.options.timeout.unwrap_or_default(),
         )),
     }
-    if args.format == Format::Text {
+    if args.format == Format::Text && !args.quiet {
         let r = &report;
         let found = match &r.outcome {
             Outcome::Plan(p) => format!(
