@@ -4,7 +4,7 @@
 //! supporters, relaxed plan extraction, preferred operators), and blind.
 //! Negative conditions are ignored, as in Fast Downward's relaxation.
 
-use crate::task::{holds, Task};
+use crate::task::{holds, Lit, Task};
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
@@ -22,6 +22,62 @@ pub enum Heuristic {
 
 const INF: u64 = u64::MAX / 4;
 
+/// The open facts of the cost computation: a binary heap, or buckets by
+/// cost when every cost is small (unit costs).
+enum Queue {
+    Heap(BinaryHeap<Reverse<(u64, u32)>>),
+    Buckets(Vec<Vec<u32>>, usize),
+}
+
+impl Queue {
+    fn clear(&mut self) {
+        match self {
+            Queue::Heap(h) => h.clear(),
+            Queue::Buckets(b, cur) => {
+                b.iter_mut().for_each(Vec::clear);
+                *cur = 0;
+            }
+        }
+    }
+
+    fn push(&mut self, c: u64, f: u32) {
+        match self {
+            Queue::Heap(h) => h.push(Reverse((c, f))),
+            Queue::Buckets(b, cur) if c >= 1 << 20 => {
+                // Too many buckets: continue with a heap.
+                let mut h = BinaryHeap::new();
+                for (i, fs) in b.iter().enumerate().skip(*cur) {
+                    h.extend(fs.iter().map(|&f| Reverse((i as u64, f))));
+                }
+                h.push(Reverse((c, f)));
+                *self = Queue::Heap(h);
+            }
+            Queue::Buckets(b, _) => {
+                let c = c as usize;
+                if b.len() <= c {
+                    b.resize_with(c + 1, Vec::new);
+                }
+                b[c].push(f);
+            }
+        }
+    }
+
+    fn pop(&mut self) -> Option<(u64, u32)> {
+        match self {
+            Queue::Heap(h) => h.pop().map(|Reverse(x)| x),
+            Queue::Buckets(b, cur) => {
+                while *cur < b.len() {
+                    if let Some(f) = b[*cur].pop() {
+                        return Some((*cur as u64, f));
+                    }
+                    *cur += 1;
+                }
+                None
+            }
+        }
+    }
+}
+
 struct UnaryOp {
     pre: Vec<u32>,
     eff: u32,
@@ -36,13 +92,17 @@ pub struct Evaluator {
     pre_of: Vec<Vec<u32>>,
     no_pre: Vec<u32>,
     goal: Vec<u32>,
+    /// The facts with complements, in complement order (complement `i` is
+    /// fact `num_facts + i`).
+    complements: Vec<u32>,
     min_cost: u64,
     // scratch
     cost: Vec<u64>,
     supporter: Vec<u32>,
     unsat: Vec<u32>,
     acc: Vec<u64>,
-    heap: BinaryHeap<Reverse<(u64, u32)>>,
+    heap: Queue,
+    unsat_init: Vec<u32>,
     marked: Vec<bool>,
     in_plan: Vec<bool>,
     stack: Vec<u32>,
@@ -54,34 +114,65 @@ impl Evaluator {
     /// `unit`: count every operator as cost 1 (greedy search measures
     /// distance in steps); otherwise use the task's costs.
     pub fn new(task: &Task, kind: Heuristic, unit: bool) -> Evaluator {
+        // Facts some condition needs false get a complement fact, true
+        // when they are false and made true by the effects that delete
+        // them: negative conditions then guide the relaxation too.
+        let nf0 = task.num_facts();
+        let mut comp = vec![u32::MAX; nf0];
+        let mut complements = Vec::new();
+        {
+            let mut need = |l: &Lit| {
+                if !l.positive
+                    && !task.derived[l.fact as usize]
+                    && comp[l.fact as usize] == u32::MAX
+                {
+                    comp[l.fact as usize] = (nf0 + complements.len()) as u32;
+                    complements.push(l.fact);
+                }
+            };
+            for o in &task.operators {
+                o.pre.iter().for_each(&mut need);
+                o.effects.iter().flat_map(|e| &e.cond).for_each(&mut need);
+            }
+            task.axioms.iter().flat_map(|a| &a.body).for_each(&mut need);
+            task.goal.iter().for_each(&mut need);
+        }
+        let lits = |ls: &[Lit], out: &mut Vec<u32>| {
+            for l in ls {
+                if l.positive {
+                    out.push(l.fact);
+                } else if comp[l.fact as usize] != u32::MAX {
+                    out.push(comp[l.fact as usize]);
+                }
+            }
+        };
         let mut ops = Vec::new();
         for (i, o) in task.operators.iter().enumerate() {
-            let base: Vec<u32> = o
-                .pre
-                .iter()
-                .filter(|l| l.positive)
-                .map(|l| l.fact)
-                .collect();
-            for e in o.effects.iter().filter(|e| e.add) {
+            let mut base = Vec::new();
+            lits(&o.pre, &mut base);
+            for e in &o.effects {
+                let eff = if e.add {
+                    e.fact
+                } else if comp[e.fact as usize] != u32::MAX {
+                    comp[e.fact as usize]
+                } else {
+                    continue;
+                };
                 let mut pre = base.clone();
-                pre.extend(e.cond.iter().filter(|l| l.positive).map(|l| l.fact));
+                lits(&e.cond, &mut pre);
                 pre.sort_unstable();
                 pre.dedup();
                 ops.push(UnaryOp {
                     pre,
-                    eff: e.fact,
+                    eff,
                     cost: if unit { 1 } else { o.cost },
                     op: Some(i as u32),
                 });
             }
         }
         for a in &task.axioms {
-            let mut pre: Vec<u32> = a
-                .body
-                .iter()
-                .filter(|l| l.positive)
-                .map(|l| l.fact)
-                .collect();
+            let mut pre = Vec::new();
+            lits(&a.body, &mut pre);
             pre.sort_unstable();
             pre.dedup();
             ops.push(UnaryOp {
@@ -91,7 +182,9 @@ impl Evaluator {
                 op: None,
             });
         }
-        let nf = task.num_facts();
+        let mut goal = Vec::new();
+        lits(&task.goal, &mut goal);
+        let nf = nf0 + complements.len();
         let mut pre_of = vec![Vec::new(); nf];
         let mut no_pre = Vec::new();
         for (i, u) in ops.iter().enumerate() {
@@ -111,12 +204,8 @@ impl Evaluator {
         let n = ops.len();
         Evaluator {
             kind,
-            goal: task
-                .goal
-                .iter()
-                .filter(|l| l.positive)
-                .map(|l| l.fact)
-                .collect(),
+            goal,
+            complements,
             ops,
             pre_of,
             no_pre,
@@ -125,7 +214,12 @@ impl Evaluator {
             supporter: vec![u32::MAX; nf],
             unsat: vec![0; n],
             acc: vec![0; n],
-            heap: BinaryHeap::new(),
+            heap: if unit {
+                Queue::Buckets(Vec::new(), 0)
+            } else {
+                Queue::Heap(BinaryHeap::new())
+            },
+            unsat_init: Vec::new(),
             marked: vec![false; nf],
             in_plan: vec![false; task.operators.len()],
             stack: Vec::new(),
@@ -142,21 +236,31 @@ impl Evaluator {
         }
         let max = self.kind == Heuristic::Max;
         self.cost.iter_mut().for_each(|c| *c = INF);
-        for (i, u) in self.ops.iter().enumerate() {
-            self.unsat[i] = u.pre.len() as u32;
-            self.acc[i] = 0;
+        if self.unsat_init.len() != self.ops.len() {
+            self.unsat_init = self.ops.iter().map(|u| u.pre.len() as u32).collect();
         }
+        self.unsat.copy_from_slice(&self.unsat_init);
+        self.acc.iter_mut().for_each(|a| *a = 0);
         self.heap.clear();
+        let nf0 = self.cost.len() - self.complements.len();
         for (w, &word) in s.iter().enumerate() {
             let mut bits = word;
             while bits != 0 {
                 let f = (w * 64) as u32 + bits.trailing_zeros();
                 bits &= bits - 1;
-                if (f as usize) < self.cost.len() {
+                if (f as usize) < nf0 {
                     self.cost[f as usize] = 0;
                     self.supporter[f as usize] = u32::MAX;
-                    self.heap.push(Reverse((0, f)));
+                    self.heap.push(0, f);
                 }
+            }
+        }
+        for (i, &f) in self.complements.iter().enumerate() {
+            if !crate::task::test(s, f) {
+                let c = (nf0 + i) as u32;
+                self.cost[c as usize] = 0;
+                self.supporter[c as usize] = u32::MAX;
+                self.heap.push(0, c);
             }
         }
         for i in 0..self.no_pre.len() {
@@ -165,10 +269,10 @@ impl Evaluator {
             if u.cost < self.cost[u.eff as usize] {
                 self.cost[u.eff as usize] = u.cost;
                 self.supporter[u.eff as usize] = ui;
-                self.heap.push(Reverse((u.cost, u.eff)));
+                self.heap.push(u.cost, u.eff);
             }
         }
-        while let Some(Reverse((c, f))) = self.heap.pop() {
+        while let Some((c, f)) = self.heap.pop() {
             if c > self.cost[f as usize] {
                 continue;
             }
@@ -186,7 +290,7 @@ impl Evaluator {
                     if nc < self.cost[u.eff as usize] {
                         self.cost[u.eff as usize] = nc;
                         self.supporter[u.eff as usize] = ui;
-                        self.heap.push(Reverse((nc, u.eff)));
+                        self.heap.push(nc, u.eff);
                     }
                 }
             }

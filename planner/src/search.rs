@@ -231,6 +231,8 @@ impl<'t> Search<'t> {
             expanded_g: u64::MAX,
         });
         let use_pref = self.opts.heuristic == Heuristic::Ff;
+        // The preferred operators of each state, from its evaluation.
+        let mut prefs: Vec<Box<[u32]>> = vec![self.eval.preferred.as_slice().into()];
         // Two open lists (all successors; successors by preferred
         // operators), picked by priority; progress boosts the preferred one.
         let mut open: [BinaryHeap<Reverse<(u64, u64, u32)>>; 2] =
@@ -271,11 +273,8 @@ impl<'t> Search<'t> {
             }
             self.stats.expanded += 1;
             if use_pref {
-                // Preferred operators of this state (re-evaluated: cheap
-                // next to the successors' evaluations).
-                self.eval.eval(task, &state);
                 pref.clear();
-                pref.extend_from_slice(&self.eval.preferred);
+                pref.extend_from_slice(&prefs[id as usize]);
             }
             self.succ.applicable(task, &state, &mut app);
             for &o in &app {
@@ -288,6 +287,9 @@ impl<'t> Search<'t> {
                 }
                 self.stats.evaluated += 1;
                 let h = self.eval.eval(task, &next);
+                if use_pref {
+                    prefs.push(self.eval.preferred.as_slice().into());
+                }
                 self.nodes.push(Node {
                     parent: id,
                     op: o,
