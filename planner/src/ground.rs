@@ -910,3 +910,98 @@ fn instantiate(
         cost,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_util::{rooms, task};
+
+    fn lit(f: u32, positive: bool) -> GF {
+        GF::Lit(Lit { fact: f, positive })
+    }
+
+    #[test]
+    fn formulas_simplify_as_they_are_built() {
+        assert_eq!(gand(vec![GF::True, lit(1, true)]), lit(1, true));
+        assert_eq!(gand(vec![lit(1, true), GF::False]), GF::False);
+        assert_eq!(gor(vec![GF::False, GF::False]), GF::False);
+        assert_eq!(gor(vec![lit(1, true), GF::True]), GF::True);
+        assert_eq!(
+            gand(vec![gand(vec![lit(1, true), lit(2, true)]), lit(3, false)]),
+            GF::And(vec![lit(1, true), lit(2, true), lit(3, false)])
+        );
+        assert_eq!(
+            negate(gor(vec![lit(1, true), lit(2, false)])),
+            GF::And(vec![lit(1, false), lit(2, true)])
+        );
+    }
+
+    #[test]
+    fn regression_through_start_effects() {
+        let value: FxHashMap<u32, bool> = [(1, true), (2, false)].into_iter().collect();
+        let f = gand(vec![lit(1, true), lit(3, true)]);
+        assert_eq!(regress(f, &value), lit(3, true));
+        assert_eq!(regress(lit(2, true), &value), GF::False);
+        assert_eq!(regress(lit(2, false), &value), GF::True);
+    }
+
+    #[test]
+    fn joins_follow_shared_variables() {
+        // (at ?p ?a) (road ?x ?y) (link ?a ?x): the link comes second.
+        let at = (0, vec![LTerm::Slot(0), LTerm::Slot(1)]);
+        let road = (1, vec![LTerm::Slot(2), LTerm::Slot(3)]);
+        let link = (2, vec![LTerm::Slot(1), LTerm::Slot(2)]);
+        let order = join_order(vec![at, road, link], 4);
+        assert_eq!(order.iter().map(|a| a.0).collect::<Vec<_>>(), [0, 2, 1]);
+    }
+
+    #[test]
+    fn static_facts_are_compiled_away() {
+        let t = rooms();
+        assert!(t.fact_names.iter().all(|n| !n.starts_with("(door")));
+        assert!(t.fact_names.iter().all(|n| n != "(locked)"));
+        // `locked` holds, so every `go` needs the key: no auxiliary fact
+        // is left for the `or`.
+        assert!(t.fact_names.iter().all(|n| !n.starts_with("(aux")));
+    }
+
+    #[test]
+    fn unreachable_atoms_and_actions_are_pruned() {
+        let t = task(
+            include_str!("../tests/fixtures/rooms-domain.pddl"),
+            include_str!("../tests/fixtures/rooms-unsolvable.pddl"),
+        );
+        // No door leads into the hall.
+        assert!(!t.fact_names.iter().any(|n| n == "(at hall)"));
+        // From the lab: take the key there, go to the vault, take it there.
+        assert_eq!(t.operators.len(), 3, "{:?}", t.operators);
+    }
+
+    #[test]
+    fn durative_actions_fold_start_and_end() {
+        let t = task(
+            include_str!("../../examples/p3_assembler/domain.pddl"),
+            include_str!("../../examples/p3_assembler/problem.pddl"),
+        );
+        // MOVE_TO deletes `at ?from` at start and adds `at ?to` at end.
+        let mv = t
+            .operators
+            .iter()
+            .find(|o| o.action == 0 && o.args[1] != o.args[2])
+            .expect("a move");
+        assert_eq!(mv.effects.iter().filter(|e| e.add).count(), 1);
+        assert_eq!(mv.effects.iter().filter(|e| !e.add).count(), 1);
+        // A self-move keeps the robot where it is: the end add wins.
+        let stay = t
+            .operators
+            .iter()
+            .find(|o| {
+                o.action == 0 && o.args[1] == o.args[2] && crate::task::holds(&t.init, &o.pre)
+            })
+            .expect("a self-move where the robot is");
+        let mut out = Vec::new();
+        let mut ax = crate::task::AxiomScratch::default();
+        t.apply(stay, &t.init, &mut out, &mut ax);
+        assert_eq!(out, t.init);
+    }
+}

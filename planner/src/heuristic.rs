@@ -338,3 +338,72 @@ impl Evaluator {
         Some(hff)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_util::rooms;
+
+    /// The rooms fixture by hand: `take` (1) makes `holding` and with it
+    /// the door condition; `go hall lab` (2), `go lab vault` (3) reaches the
+    /// vault, and moves the held key along.
+    #[test]
+    fn heuristic_values_of_the_rooms_fixture() {
+        let t = rooms();
+        let h = |kind| Evaluator::new(&t, kind, false).eval(&t, &t.init);
+        assert_eq!(h(Heuristic::Max), Some(3));
+        // `locked` is static, so the door condition is `holding`. At vault:
+        // 1 + at lab (2) + holding (1) = 4; key in vault: the same
+        // operator, its `when (holding)` condition adds nothing new: 4.
+        assert_eq!(h(Heuristic::Add), Some(8));
+        assert_eq!(h(Heuristic::Ff), Some(3));
+        assert_eq!(h(Heuristic::Blind), Some(1));
+    }
+
+    #[test]
+    fn preferred_operators_apply_in_the_state() {
+        let t = rooms();
+        let mut e = Evaluator::new(&t, Heuristic::Ff, true);
+        e.eval(&t, &t.init);
+        assert_eq!(e.preferred.len(), 1);
+        let op = &t.operators[e.preferred[0] as usize];
+        assert!(holds(&t.init, &op.pre));
+    }
+
+    #[test]
+    fn goal_states_have_value_zero_and_dead_ends_none() {
+        let t = crate::test_util::task(
+            include_str!("../tests/fixtures/rooms-domain.pddl"),
+            include_str!("../tests/fixtures/rooms-unsolvable.pddl"),
+        );
+        for kind in [Heuristic::Max, Heuristic::Add, Heuristic::Ff] {
+            assert_eq!(Evaluator::new(&t, kind, false).eval(&t, &t.init), None);
+        }
+        let t = rooms();
+        let mut goal = t.init.clone();
+        for l in &t.goal {
+            crate::task::set(&mut goal, l.fact);
+        }
+        for kind in [
+            Heuristic::Max,
+            Heuristic::Add,
+            Heuristic::Ff,
+            Heuristic::Blind,
+        ] {
+            assert_eq!(Evaluator::new(&t, kind, false).eval(&t, &goal), Some(0));
+        }
+    }
+
+    #[test]
+    fn the_bucket_queue_falls_back_to_a_heap_for_large_costs() {
+        let mut q = Queue::Buckets(Vec::new(), 0);
+        q.push(3, 7);
+        q.push(1 << 30, 8);
+        q.push(2, 9);
+        assert!(matches!(q, Queue::Heap(_)));
+        assert_eq!(q.pop(), Some((2, 9)));
+        assert_eq!(q.pop(), Some((3, 7)));
+        assert_eq!(q.pop(), Some((1 << 30, 8)));
+        assert_eq!(q.pop(), None);
+    }
+}

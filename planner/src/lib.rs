@@ -168,3 +168,37 @@ pub fn timeout(problem: &Problem, limit: Duration) -> Diagnostic {
     )
     .with_hint("raise `--timeout`, or try `--search gbfs --heuristic ff`")
 }
+
+#[cfg(test)]
+pub(crate) mod test_util {
+    use btc_lang::pipeline::{domain_unit_from, problem_unit_from};
+    use btc_lang::state::World;
+
+    /// The ground task of a domain and problem text (fixtures from
+    /// `tests/fixtures/`).
+    pub fn task(domain: &str, problem: &str) -> crate::task::Task {
+        let du = domain_unit_from(domain, 0);
+        let d = du.domain.as_ref().expect("domain parses");
+        let pu = problem_unit_from(problem, 1, Some(d), &du.index);
+        let p = pu.problem.as_ref().expect("problem parses");
+        let world = World::new(d, &du.index, &pu.index);
+        let init = world.initial_state(p);
+        crate::ground::ground(d, &du.index, &pu.index, &init, p.goal.as_ref())
+            .expect("grounds")
+            .0
+    }
+
+    pub fn rooms() -> crate::task::Task {
+        task(
+            include_str!("../tests/fixtures/rooms-domain.pddl"),
+            include_str!("../tests/fixtures/rooms-problem.pddl"),
+        )
+    }
+
+    pub fn fact(t: &crate::task::Task, name: &str) -> u32 {
+        t.fact_names
+            .iter()
+            .position(|n| n == name)
+            .unwrap_or_else(|| panic!("no fact {name}")) as u32
+    }
+}

@@ -384,3 +384,51 @@ impl<'t> Search<'t> {
         SearchResult::Unsolvable
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_util::rooms;
+
+    #[test]
+    fn the_registry_stores_each_state_once() {
+        let mut r = Registry::new(2);
+        assert_eq!(r.insert(&[1, 2]), (0, true));
+        assert_eq!(r.insert(&[3, 4]), (1, true));
+        assert_eq!(r.insert(&[1, 2]), (0, false));
+        assert_eq!(r.get(1), &[3, 4]);
+    }
+
+    #[test]
+    fn successors_are_the_applicable_operators() {
+        let t = rooms();
+        let succ = Successors::new(&t);
+        let mut ax = AxiomScratch::default();
+        let (mut s, mut next, mut app) = (t.init.clone(), Vec::new(), Vec::new());
+        for _ in 0..3 {
+            succ.applicable(&t, &s, &mut app);
+            app.sort_unstable();
+            let scan: Vec<u32> = (0..t.operators.len() as u32)
+                .filter(|&o| holds(&s, &t.operators[o as usize].pre))
+                .collect();
+            assert_eq!(app, scan);
+            let Some(&o) = app.first() else { break };
+            t.apply(&t.operators[o as usize], &s, &mut next, &mut ax);
+            std::mem::swap(&mut s, &mut next);
+        }
+    }
+
+    #[test]
+    fn astar_finds_the_cheapest_plan() {
+        let t = rooms();
+        for heuristic in [Heuristic::Max, Heuristic::Blind] {
+            let opts = Options {
+                algorithm: Algorithm::Astar,
+                heuristic,
+                timeout: None,
+            };
+            let mut s = Search::new(&t, opts);
+            assert!(matches!(s.run(), SearchResult::Plan(p, 3) if p.len() == 3));
+        }
+    }
+}

@@ -206,3 +206,91 @@ impl AxiomScratch {
         self.waiting = vec![0; t.axioms.len()];
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_util::{fact, rooms};
+
+    #[test]
+    fn bits_set_clear_and_test() {
+        let mut s = vec![0u64; 2];
+        set(&mut s, 3);
+        set(&mut s, 70);
+        assert!(test(&s, 3) && test(&s, 70) && !test(&s, 4));
+        clear(&mut s, 70);
+        assert!(!test(&s, 70));
+        assert!(holds(
+            &s,
+            &[
+                Lit::pos(3),
+                Lit {
+                    fact: 4,
+                    positive: false
+                }
+            ]
+        ));
+        assert!(!holds(&s, &[Lit::pos(4)]));
+    }
+
+    #[test]
+    fn deletes_go_first_and_conditions_read_the_state_before() {
+        let t = Task {
+            fact_names: vec!["(a)".into(), "(b)".into(), "(c)".into()],
+            derived: vec![false; 3],
+            words: 1,
+            ..Task::default()
+        };
+        let o = Operator {
+            action: 0,
+            args: Vec::new(),
+            pre: Vec::new(),
+            effects: vec![
+                // (a) deleted and added: stays true.
+                GroundEffect {
+                    cond: vec![],
+                    fact: 0,
+                    add: false,
+                },
+                GroundEffect {
+                    cond: vec![],
+                    fact: 0,
+                    add: true,
+                },
+                // (b) is deleted; (c) is added when (b) held before.
+                GroundEffect {
+                    cond: vec![],
+                    fact: 1,
+                    add: false,
+                },
+                GroundEffect {
+                    cond: vec![Lit::pos(1)],
+                    fact: 2,
+                    add: true,
+                },
+            ],
+            cost: 1,
+        };
+        let mut out = Vec::new();
+        let mut ax = AxiomScratch::default();
+        t.apply(&o, &[0b011], &mut out, &mut ax);
+        assert_eq!(out, [0b101]);
+    }
+
+    #[test]
+    fn derived_facts_follow_the_state() {
+        let t = rooms();
+        let reach_vault = fact(&t, "(reachable vault)");
+        let at_hall = fact(&t, "(at hall)");
+        assert!(test(&t.init, reach_vault), "the doors lead on to the vault");
+        let mut s = t.init.clone();
+        clear(&mut s, at_hall);
+        let mut ax = AxiomScratch::default();
+        t.close(&mut s, &mut ax);
+        assert!(!test(&s, reach_vault), "nowhere to start from");
+        set(&mut s, fact(&t, "(at lab)"));
+        t.close(&mut s, &mut ax);
+        assert!(test(&s, reach_vault));
+        assert!(!test(&s, fact(&t, "(reachable hall)")));
+    }
+}
