@@ -43,7 +43,7 @@ impl Queue {
     fn push(&mut self, c: u64, f: u32) {
         match self {
             Queue::Heap(h) => h.push(Reverse((c, f))),
-            Queue::Buckets(b, cur) if c >= 1 << 20 => {
+            Queue::Buckets(b, cur) if c >= 1 << 14 => {
                 // Too many buckets: continue with a heap.
                 let mut h = BinaryHeap::new();
                 for (i, fs) in b.iter().enumerate().skip(*cur) {

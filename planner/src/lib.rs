@@ -17,7 +17,7 @@ pub use heuristic::Heuristic;
 pub use search::{Algorithm, Options, SearchStats};
 
 use btc_lang::diagnostic::{codes, Diagnostic};
-use btc_lang::pddl::ast::{Domain, Formula, Problem};
+use btc_lang::pddl::ast::{Domain, Formula, InitFact, Problem};
 use btc_lang::pddl::check::{DomainIndex, ProblemIndex};
 use btc_lang::state::{State, World};
 use std::time::{Duration, Instant};
@@ -68,7 +68,19 @@ pub fn plan(
     opts: &Options,
 ) -> Result<Report, Vec<Diagnostic>> {
     let world = World::new(domain, dix, pix);
-    let init = world.initial_state(problem);
+    // The facts and values of `:init`; derived atoms are the planner's job.
+    let mut init = State::default();
+    let env = Vec::new();
+    for f in &problem.init {
+        match f {
+            InitFact::Atom { atom } => init.facts.extend(world.atom_key(atom, &env)),
+            InitFact::Value { fluent, value, .. } => {
+                if let Some(k) = world.fluent_key(fluent, &env) {
+                    init.fluents.insert(k, *value);
+                }
+            }
+        }
+    }
     plan_from(domain, dix, pix, &init, problem.goal.as_ref(), opts)
 }
 
