@@ -133,7 +133,7 @@ enum Command {
 enum SearchArg {
     /// Greedy best-first search (fast, not optimal).
     Gbfs,
-    /// A* (optimal with `max` or `blind`).
+    /// A* (optimal with `lmcut`, `max` or `blind`).
     Astar,
 }
 
@@ -147,6 +147,9 @@ enum HeuristicArg {
     Max,
     /// No guidance (admissible).
     Blind,
+    /// LM-cut (admissible; h_max where the task has conditional effects or
+    /// derived predicates).
+    Lmcut,
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -196,6 +199,7 @@ fn plan_options(
             HeuristicArg::Add => Heuristic::Add,
             HeuristicArg::Max => Heuristic::Max,
             HeuristicArg::Blind => Heuristic::Blind,
+            HeuristicArg::Lmcut => Heuristic::LmCut,
         },
         timeout,
     })

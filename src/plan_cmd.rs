@@ -5,7 +5,7 @@ use crate::{files, report, Format};
 use btc_lang::diagnostic::has_errors;
 use btc_lang::pipeline::{domain_unit, problem_unit};
 use btc_lang::source::Sources;
-use btc_planner::{Options, Outcome};
+use btc_planner::{Heuristic, Options, Outcome};
 use std::path::Path;
 use std::process::ExitCode;
 
@@ -74,6 +74,10 @@ pub fn run(args: &PlanArgs) -> anyhow::Result<ExitCode> {
     }
     if args.format == Format::Text && !args.quiet {
         let r = &report;
+        if args.options.heuristic == Heuristic::LmCut && r.search.heuristic == Some(Heuristic::Max)
+        {
+            eprintln!("note: LM-cut needs a task without conditional effects and derived predicates; h_max was used");
+        }
         let found = match &r.outcome {
             Outcome::Plan(p) => format!(
                 "plan: {}, cost {}",

@@ -18,6 +18,9 @@ pub enum Heuristic {
     Max,
     /// 0 in goal states, the cheapest action's cost elsewhere (admissible).
     Blind,
+    /// LM-cut (admissible); h_max on tasks with conditional effects or
+    /// derived predicates.
+    LmCut,
 }
 
 const INF: u64 = u64::MAX / 4;
@@ -88,6 +91,7 @@ struct UnaryOp {
 
 pub struct Evaluator {
     kind: Heuristic,
+    lmcut: Option<crate::lmcut::LmCut>,
     ops: Vec<UnaryOp>,
     pre_of: Vec<Vec<u32>>,
     no_pre: Vec<u32>,
@@ -114,6 +118,12 @@ impl Evaluator {
     /// `unit`: count every operator as cost 1 (greedy search measures
     /// distance in steps); otherwise use the task's costs.
     pub fn new(task: &Task, kind: Heuristic, unit: bool) -> Evaluator {
+        let lmcut = (kind == Heuristic::LmCut && crate::lmcut::LmCut::supports(task))
+            .then(|| crate::lmcut::LmCut::new(task));
+        let kind = match kind {
+            Heuristic::LmCut if lmcut.is_none() => Heuristic::Max,
+            k => k,
+        };
         // Facts some condition needs false get a complement fact, true
         // when they are false and made true by the effects that delete
         // them: negative conditions then guide the relaxation too.
@@ -204,6 +214,7 @@ impl Evaluator {
         let n = ops.len();
         Evaluator {
             kind,
+            lmcut,
             goal,
             complements,
             ops,
@@ -227,10 +238,18 @@ impl Evaluator {
         }
     }
 
+    /// The heuristic this evaluator computes (LM-cut falls back to h_max).
+    pub fn kind(&self) -> Heuristic {
+        self.kind
+    }
+
     /// The heuristic value of `s`; `None` when the goal is unreachable even
     /// in the relaxation (a dead end).
     pub fn eval(&mut self, task: &Task, s: &[u64]) -> Option<u64> {
         self.preferred.clear();
+        if let Some(l) = &mut self.lmcut {
+            return l.eval(s);
+        }
         if self.kind == Heuristic::Blind {
             return Some(if task.is_goal(s) { 0 } else { self.min_cost });
         }

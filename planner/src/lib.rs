@@ -9,6 +9,7 @@
 pub mod ground;
 pub mod heuristic;
 pub mod lifted;
+pub mod lmcut;
 pub mod search;
 pub mod task;
 

@@ -38,6 +38,8 @@ impl Default for Options {
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SearchStats {
+    /// The heuristic used (LM-cut falls back to h_max where it does not apply).
+    pub heuristic: Option<Heuristic>,
     pub expanded: usize,
     pub generated: usize,
     pub evaluated: usize,
@@ -172,15 +174,19 @@ pub struct Search<'t> {
 impl<'t> Search<'t> {
     pub fn new(task: &'t Task, opts: Options) -> Search<'t> {
         let unit = opts.algorithm == Algorithm::Gbfs;
+        let eval = Evaluator::new(task, opts.heuristic, unit);
         Search {
             task,
             opts,
             succ: Successors::new(task),
-            eval: Evaluator::new(task, opts.heuristic, unit),
+            stats: SearchStats {
+                heuristic: Some(eval.kind()),
+                ..SearchStats::default()
+            },
+            eval,
             reg: Registry::new(task.words),
             nodes: Vec::new(),
             ax: AxiomScratch::default(),
-            stats: SearchStats::default(),
         }
     }
 
