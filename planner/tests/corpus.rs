@@ -145,3 +145,59 @@ fn astar_with_h_max_and_with_blind_search_agree_on_small_problems() {
         }
     }
 }
+
+/// On the initial state of every corpus problem with an optimal reference,
+/// h_max <= LM-cut <= the optimal cost (LM-cut dominates h_max and is
+/// admissible), and A* with LM-cut finds the optimal cost on the subset.
+#[test]
+fn lm_cut_lies_between_h_max_and_the_optimal_cost() {
+    use btc_lang::state::World;
+    use btc_planner::heuristic::Evaluator;
+    let optimal = optimal_domains();
+    let mut checked = 0;
+    for (domain, problem) in corpus_problems() {
+        let Some((_, o1, o2)) = optimal.iter().find(|(d, _, _)| *d == domain) else {
+            continue;
+        };
+        if !(if problem == "p01" { *o1 } else { *o2 }) {
+            continue;
+        }
+        let (d, p) = corpus_case(&domain, &problem);
+        let l = load(&d, &p);
+        let (dom, prob) = (
+            l.du.domain.as_ref().unwrap(),
+            l.pu.problem.as_ref().unwrap(),
+        );
+        let init = World::new(dom, &l.du.index, &l.pu.index).initial_state(prob);
+        let (task, _) =
+            btc_planner::ground::ground(dom, &l.du.index, &l.pu.index, &init, prob.goal.as_ref())
+                .unwrap();
+        let h = |kind| {
+            Evaluator::new(&task, kind, false)
+                .eval(&task, &task.init)
+                .expect("solvable")
+        };
+        let (max, lmcut) = (h(Heuristic::Max), h(Heuristic::LmCut));
+        let reference = stated_cost(&corpus_dir().join(&domain).join(format!("{problem}.plan")));
+        assert!(
+            max <= lmcut,
+            "{domain}/{problem}: h_max {max} > LM-cut {lmcut}"
+        );
+        assert!(
+            lmcut as f64 <= reference,
+            "{domain}/{problem}: LM-cut {lmcut} > optimal {reference}"
+        );
+        checked += 1;
+    }
+    assert!(checked >= 30, "checked {checked}");
+    let opts = Options {
+        algorithm: Algorithm::Astar,
+        heuristic: Heuristic::LmCut,
+        timeout: None,
+    };
+    for (domain, problem) in [("logistics", "p01"), ("depot", "p02"), ("elevators", "p01")] {
+        let (d, p) = corpus_case(domain, problem);
+        let reference = stated_cost(&corpus_dir().join(domain).join(format!("{problem}.plan")));
+        assert_eq!(load(&d, &p).solve_and_validate(&opts).1, reference);
+    }
+}
