@@ -225,7 +225,7 @@ impl Evaluator {
             supporter: vec![u32::MAX; nf],
             unsat: vec![0; n],
             acc: vec![0; n],
-            heap: if unit {
+            heap: if unit || task.operators.iter().all(|o| o.cost <= 100) {
                 Queue::Buckets(Vec::new(), 0)
             } else {
                 Queue::Heap(BinaryHeap::new())
