@@ -41,6 +41,7 @@ pub fn run(args: &PlanArgs) -> anyhow::Result<ExitCode> {
         }
     };
     let stats = serde_json::json!({
+        "heuristic": report.search.heuristic.map(|h| format!("{h:?}").to_lowercase()),
         "reachable_atoms": report.ground.reachable_atoms,
         "operators": report.ground.operators,
         "axioms": report.ground.axioms,
