@@ -12,6 +12,8 @@ use btc_lang::pddl::check::{DomainIndex, ProblemIndex};
 use btc_lang::source::Span;
 use btc_lang::state::State;
 use rustc_hash::{FxHashMap, FxHashSet};
+use std::cell::Cell;
+use std::time::Instant;
 
 /// What grounding found, for the statistics line.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -155,9 +157,25 @@ struct Grounder<'a> {
     axioms: Vec<Axiom>,
     state: &'a State,
     diags: Vec<Diagnostic>,
+    deadline: Option<Instant>,
+    ticks: Cell<u32>,
+    timed_out: Cell<bool>,
 }
 
 impl Grounder<'_> {
+    /// Whether the deadline has passed (the clock is read every 4096 calls).
+    fn expired(&self) -> bool {
+        if self.timed_out.get() {
+            return true;
+        }
+        let t = self.ticks.get().wrapping_add(1);
+        self.ticks.set(t);
+        if t.is_multiple_of(4096) && self.deadline.is_some_and(|d| Instant::now() >= d) {
+            self.timed_out.set(true);
+        }
+        self.timed_out.get()
+    }
+
     fn is_static(&self, pred: u32) -> bool {
         !self.fluent[pred as usize] && !self.derived[pred as usize]
     }
@@ -240,6 +258,9 @@ impl Grounder<'_> {
         env: &mut [Option<u32>],
         leaf: &mut dyn FnMut(&[u32]),
     ) {
+        if self.expired() {
+            return;
+        }
         if let Some(((pred, args), rest)) = atoms.split_first() {
             let mut bound = [0usize; MAX_ARITY];
             for t in &self.by_pred[*pred as usize] {
@@ -287,8 +308,12 @@ impl Grounder<'_> {
                 env[s] = None;
             }
             _ => {
-                let b: Vec<u32> = env[..params.len()].iter().map(|o| o.unwrap_or(0)).collect();
-                leaf(&b);
+                let mut b = [0u32; MAX_PARAMS];
+                let n = params.len().min(MAX_PARAMS);
+                for (d, o) in b.iter_mut().zip(&env[..n]) {
+                    *d = o.unwrap_or(0);
+                }
+                leaf(&b[..n]);
             }
         }
     }
@@ -523,7 +548,8 @@ pub fn ground(
     pix: &ProblemIndex,
     state: &State,
     goal: Option<&Formula>,
-) -> Result<(Task, GroundStats), Vec<Diagnostic>> {
+    deadline: Option<Instant>,
+) -> Result<Option<(Task, GroundStats)>, Vec<Diagnostic>> {
     let mut c = Compiler::new(domain, dix, pix);
     let mut schemas: Vec<Schema> = (0..domain.actions.len()).map(|i| c.action(i)).collect();
     schemas.extend((0..domain.derived.len()).map(|i| c.derived(i)));
@@ -596,6 +622,9 @@ pub fn ground(
         axioms: Vec::new(),
         state,
         diags: Vec::new(),
+        deadline,
+        ticks: Cell::new(0),
+        timed_out: Cell::new(false),
     };
     let mut init: Vec<&Box<[u32]>> = state.facts.iter().collect();
     init.sort();
@@ -640,31 +669,28 @@ pub fn ground(
         let mut changed = false;
         for (i, s) in schemas.iter().enumerate() {
             let (atoms, allowed) = &prepared[i];
-            let mut found: Vec<Box<[u32]>> = Vec::new();
             let mut env = vec![None; s.slots.max(s.params.len())];
             let mut scratch = vec![0u32; s.slots.max(1)];
+            let mut adds = Vec::new();
+            let (seen, order) = (&mut seen[i], &mut order[i]);
             g.join(atoms, &s.params, allowed, &mut env, &mut |b| {
-                if seen[i].contains(b) {
+                if seen.contains(b) {
                     return;
                 }
                 scratch[..b.len()].copy_from_slice(b);
                 if g.relaxed(&s.pre_start, &mut scratch, true) {
-                    found.push(b.into());
+                    seen.insert(b.into());
+                    g.relaxed_adds(&s.eff_start, &mut scratch, &mut adds);
+                    g.relaxed_adds(&s.eff_end, &mut scratch, &mut adds);
+                    order.push(b.into());
                 }
             });
-            let mut adds = Vec::new();
-            for b in found {
-                if !seen[i].insert(b.clone()) {
-                    continue;
-                }
-                scratch[..b.len()].copy_from_slice(&b);
-                g.relaxed_adds(&s.eff_start, &mut scratch, &mut adds);
-                g.relaxed_adds(&s.eff_end, &mut scratch, &mut adds);
-                order[i].push(b);
-            }
             for k in adds {
                 changed |= g.add_reach(k);
             }
+        }
+        if g.timed_out.get() {
+            return Ok(None);
         }
         if !changed {
             break;
@@ -685,6 +711,9 @@ pub fn ground(
     for (i, s) in schemas.iter().enumerate() {
         let mut env = vec![0u32; s.slots.max(1)];
         for b in &order[i] {
+            if g.expired() {
+                return Ok(None);
+            }
             env[..b.len()].copy_from_slice(b);
             match s.kind {
                 SchemaKind::Derived(_, head) => {
@@ -811,7 +840,7 @@ pub fn ground(
     let mut s = std::mem::take(&mut task.init);
     task.close(&mut s, &mut ax);
     task.init = s;
-    Ok((task, stats))
+    Ok(Some((task, stats)))
 }
 
 fn instantiate(

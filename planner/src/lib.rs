@@ -97,7 +97,15 @@ pub fn plan_from(
     opts: &Options,
 ) -> Result<Report, Vec<Diagnostic>> {
     let t0 = Instant::now();
-    let (task, ground) = ground::ground(domain, dix, pix, initial, goal)?;
+    let deadline = opts.timeout.map(|t| t0 + t);
+    let Some((task, ground)) = ground::ground(domain, dix, pix, initial, goal, deadline)? else {
+        return Ok(Report {
+            outcome: Outcome::Timeout,
+            ground: GroundStats::default(),
+            ground_time: t0.elapsed(),
+            search: SearchStats::default(),
+        });
+    };
     let ground_time = t0.elapsed();
     let mut opts = *opts;
     if let Some(t) = opts.timeout {
@@ -196,8 +204,9 @@ pub(crate) mod test_util {
         let p = pu.problem.as_ref().expect("problem parses");
         let world = World::new(d, &du.index, &pu.index);
         let init = world.initial_state(p);
-        crate::ground::ground(d, &du.index, &pu.index, &init, p.goal.as_ref())
+        crate::ground::ground(d, &du.index, &pu.index, &init, p.goal.as_ref(), None)
             .expect("grounds")
+            .expect("no time limit")
             .0
     }
 

@@ -16,6 +16,9 @@ use std::rc::Rc;
 /// the planner builds them in a fixed buffer, so arity is bounded.
 pub const MAX_ARITY: usize = 15;
 
+/// Bindings of action parameters are built in a fixed buffer too.
+pub const MAX_PARAMS: usize = 32;
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LTerm {
     Slot(u16),
@@ -315,6 +318,12 @@ impl<'a> Compiler<'a> {
     }
 
     fn begin(&mut self, params: &'a [Typed]) -> Vec<Rc<[u32]>> {
+        if params.len() > MAX_PARAMS {
+            self.diags.push(unsupported(
+                params[MAX_PARAMS].name.span,
+                &format!("more than {MAX_PARAMS} parameters"),
+            ));
+        }
         self.scope.clear();
         self.slots = 0;
         self.max_slots = 0;

@@ -169,9 +169,16 @@ fn lm_cut_lies_between_h_max_and_the_optimal_cost() {
             l.pu.problem.as_ref().unwrap(),
         );
         let init = World::new(dom, &l.du.index, &l.pu.index).initial_state(prob);
-        let (task, _) =
-            btc_planner::ground::ground(dom, &l.du.index, &l.pu.index, &init, prob.goal.as_ref())
-                .unwrap();
+        let (task, _) = btc_planner::ground::ground(
+            dom,
+            &l.du.index,
+            &l.pu.index,
+            &init,
+            prob.goal.as_ref(),
+            None,
+        )
+        .unwrap()
+        .unwrap();
         let h = |kind| {
             Evaluator::new(&task, kind, false)
                 .eval(&task, &task.init)

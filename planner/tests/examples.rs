@@ -203,3 +203,18 @@ fn fractional_costs_are_refused() {
     assert_eq!(diags[0].code, "S002");
     assert!(diags[0].message.contains("0.5"), "{}", diags[0].message);
 }
+
+#[test]
+fn the_time_limit_also_bounds_grounding() {
+    let l = load(
+        &fixture("blowup-domain.pddl"),
+        &fixture("blowup-problem.pddl"),
+    );
+    let opts = Options {
+        timeout: Some(Duration::from_millis(200)),
+        ..Options::default()
+    };
+    let t = std::time::Instant::now();
+    assert_eq!(l.plan(&opts).unwrap().outcome, Outcome::Timeout);
+    assert!(t.elapsed() < Duration::from_secs(5), "{:?}", t.elapsed());
+}
