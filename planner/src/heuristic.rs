@@ -29,16 +29,18 @@ const INF: u64 = u64::MAX / 4;
 /// cost when every cost is small (unit costs).
 enum Queue {
     Heap(BinaryHeap<Reverse<(u64, u32)>>),
-    Buckets(Vec<Vec<u32>>, usize),
+    /// Buckets, the current one, and one past the highest used.
+    Buckets(Vec<Vec<u32>>, usize, usize),
 }
 
 impl Queue {
     fn clear(&mut self) {
         match self {
             Queue::Heap(h) => h.clear(),
-            Queue::Buckets(b, cur) => {
-                b.iter_mut().for_each(Vec::clear);
+            Queue::Buckets(b, cur, hi) => {
+                b[..*hi].iter_mut().for_each(Vec::clear);
                 *cur = 0;
+                *hi = 0;
             }
         }
     }
@@ -46,21 +48,22 @@ impl Queue {
     fn push(&mut self, c: u64, f: u32) {
         match self {
             Queue::Heap(h) => h.push(Reverse((c, f))),
-            Queue::Buckets(b, cur) if c >= 1 << 14 => {
+            Queue::Buckets(b, cur, hi) if c >= 1 << 14 => {
                 // Too many buckets: continue with a heap.
                 let mut h = BinaryHeap::new();
-                for (i, fs) in b.iter().enumerate().skip(*cur) {
+                for (i, fs) in b[..*hi].iter().enumerate().skip(*cur) {
                     h.extend(fs.iter().map(|&f| Reverse((i as u64, f))));
                 }
                 h.push(Reverse((c, f)));
                 *self = Queue::Heap(h);
             }
-            Queue::Buckets(b, _) => {
+            Queue::Buckets(b, _, hi) => {
                 let c = c as usize;
                 if b.len() <= c {
                     b.resize_with(c + 1, Vec::new);
                 }
                 b[c].push(f);
+                *hi = (*hi).max(c + 1);
             }
         }
     }
@@ -68,8 +71,8 @@ impl Queue {
     fn pop(&mut self) -> Option<(u64, u32)> {
         match self {
             Queue::Heap(h) => h.pop().map(|Reverse(x)| x),
-            Queue::Buckets(b, cur) => {
-                while *cur < b.len() {
+            Queue::Buckets(b, cur, hi) => {
+                while *cur < *hi {
                     if let Some(f) = b[*cur].pop() {
                         return Some((*cur as u64, f));
                     }
@@ -226,7 +229,7 @@ impl Evaluator {
             unsat: vec![0; n],
             acc: vec![0; n],
             heap: if unit || task.operators.iter().all(|o| o.cost <= 100) {
-                Queue::Buckets(Vec::new(), 0)
+                Queue::Buckets(Vec::new(), 0, 0)
             } else {
                 Queue::Heap(BinaryHeap::new())
             },
@@ -414,8 +417,25 @@ mod tests {
     }
 
     #[test]
+    fn the_bucket_queue_pops_in_cost_order_and_clears() {
+        let mut q = Queue::Buckets(Vec::new(), 0, 0);
+        q.push(5, 1);
+        q.push(0, 2);
+        q.push(3, 3);
+        assert_eq!(q.pop(), Some((0, 2)));
+        q.push(3, 4);
+        assert_eq!(q.pop().map(|x| x.0), Some(3));
+        assert_eq!(q.pop().map(|x| x.0), Some(3));
+        q.clear();
+        assert_eq!(q.pop(), None);
+        q.push(1, 9);
+        assert_eq!(q.pop(), Some((1, 9)));
+        assert_eq!(q.pop(), None);
+    }
+
+    #[test]
     fn the_bucket_queue_falls_back_to_a_heap_for_large_costs() {
-        let mut q = Queue::Buckets(Vec::new(), 0);
+        let mut q = Queue::Buckets(Vec::new(), 0, 0);
         q.push(3, 7);
         q.push(1 << 30, 8);
         q.push(2, 9);
