@@ -99,6 +99,7 @@ pub struct Evaluator {
     pre_of: Vec<Vec<u32>>,
     no_pre: Vec<u32>,
     goal: Vec<u32>,
+    is_goal: Vec<bool>,
     /// The facts with complements, in complement order (complement `i` is
     /// fact `num_facts + i`).
     complements: Vec<u32>,
@@ -215,9 +216,14 @@ impl Evaluator {
             .min()
             .unwrap_or(0);
         let n = ops.len();
+        let mut is_goal = vec![false; nf];
+        for &g in &goal {
+            is_goal[g as usize] = true;
+        }
         Evaluator {
             kind,
             lmcut,
+            is_goal,
             goal,
             complements,
             ops,
@@ -294,9 +300,17 @@ impl Evaluator {
                 self.heap.push(u.cost, u.eff);
             }
         }
+        // Costs are final when popped: stop once every goal fact is.
+        let mut goals_left = self.goal.len();
         while let Some((c, f)) = self.heap.pop() {
+            if goals_left == 0 {
+                break;
+            }
             if c > self.cost[f as usize] {
                 continue;
+            }
+            if self.is_goal[f as usize] {
+                goals_left -= 1;
             }
             for &ui in &self.pre_of[f as usize] {
                 let i = ui as usize;
