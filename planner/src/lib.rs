@@ -5,6 +5,35 @@
 //! [`plan`] plans from a problem's `:init`; [`plan_from`] from any state of
 //! the problem's objects (a runtime's knowledge base) to any goal, which is
 //! what replanning needs. Nothing here prints.
+//!
+//! ```
+//! use btc_lang::pipeline::{domain_unit_from, problem_unit_from};
+//! use btc_lang::state::World;
+//! use btc_planner::{plan_from, to_sas_plan, Options, Outcome};
+//!
+//! let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/ariac/");
+//! let read = |f: &str| std::fs::read_to_string(format!("{dir}{f}")).unwrap();
+//! let du = domain_unit_from(&read("domain.pddl"), 0);
+//! let domain = du.domain.as_ref().unwrap();
+//! let pu = problem_unit_from(&read("problem.pddl"), 1, Some(domain), &du.index);
+//! let problem = pu.problem.as_ref().unwrap();
+//!
+//! // A knowledge base: the problem's facts, then what execution changed.
+//! let mut kb = World::new(domain, &du.index, &pu.index).initial_state(problem);
+//! let key = |pred: &str, args: &[&str]| -> Box<[u32]> {
+//!     let mut k = vec![du.index.predicates[pred].index as u32];
+//!     k.extend(args.iter().map(|a| pu.index.objects[*a].id));
+//!     k.into()
+//! };
+//! kb.facts.remove(&key("is_reachable", &["floor_robot", "curr_position"]));
+//! kb.facts.insert(key("is_reachable", &["floor_robot", "bin1"]));
+//!
+//! let report = plan_from(domain, &du.index, &pu.index, &kb, problem.goal.as_ref(),
+//!                        &Options::default()).unwrap();
+//! let Outcome::Plan(plan) = report.outcome else { panic!("no plan") };
+//! assert_eq!(plan.steps.len(), 3); // grasp, move, place
+//! print!("{}", to_sas_plan(domain, &pu.index, &plan));
+//! ```
 
 pub mod ground;
 pub mod heuristic;
