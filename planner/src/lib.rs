@@ -37,6 +37,7 @@
 
 pub mod ground;
 pub mod heuristic;
+pub mod improve;
 pub mod lifted;
 pub mod lmcut;
 pub mod search;
@@ -143,21 +144,27 @@ pub fn plan_from(
     let mut s = search::Search::new(&task, opts);
     let result = s.run();
     let outcome = match result {
-        search::SearchResult::Plan(ops, cost) => Outcome::Plan(Plan {
-            steps: ops
-                .iter()
-                .map(|&o| {
-                    let op = &task.operators[o as usize];
-                    Step {
-                        action: op.action,
-                        args: op.args.clone(),
-                    }
-                })
-                .collect(),
-            cost,
-            base_cost: task.base_cost,
-            unit_cost: task.unit_cost,
-        }),
+        search::SearchResult::Plan(mut ops, mut cost) => {
+            if opts.algorithm == Algorithm::Gbfs {
+                ops = improve::eliminate_redundant(&task, ops);
+                cost = ops.iter().map(|&o| task.operators[o as usize].cost).sum();
+            }
+            Outcome::Plan(Plan {
+                steps: ops
+                    .iter()
+                    .map(|&o| {
+                        let op = &task.operators[o as usize];
+                        Step {
+                            action: op.action,
+                            args: op.args.clone(),
+                        }
+                    })
+                    .collect(),
+                cost,
+                base_cost: task.base_cost,
+                unit_cost: task.unit_cost,
+            })
+        }
         search::SearchResult::Unsolvable => Outcome::Unsolvable,
         search::SearchResult::Timeout => Outcome::Timeout,
     };
