@@ -26,7 +26,7 @@ pub enum Heuristic {
 const INF: u64 = u64::MAX / 4;
 
 /// The open facts of the cost computation: a binary heap, or buckets by
-/// cost when every cost is small (unit costs).
+/// cost when every cost is small (such as unit costs).
 enum Queue {
     Heap(BinaryHeap<Reverse<(u64, u32)>>),
     /// Buckets, the current one, and one past the highest used.
@@ -119,9 +119,11 @@ pub struct Evaluator {
 }
 
 impl Evaluator {
-    /// `unit`: count every operator as cost 1 (greedy search measures
-    /// distance in steps); otherwise use the task's costs.
-    pub fn new(task: &Task, kind: Heuristic, unit: bool) -> Evaluator {
+    /// `plus_one`: count every operator as its cost plus 1, as LAMA does
+    /// (greedy search then favours short plans, but sees costs and never
+    /// takes a free action as no step at all); otherwise use the task's
+    /// costs.
+    pub fn new(task: &Task, kind: Heuristic, plus_one: bool) -> Evaluator {
         let lmcut = (kind == Heuristic::LmCut && crate::lmcut::LmCut::supports(task))
             .then(|| crate::lmcut::LmCut::new(task));
         let kind = match kind {
@@ -179,7 +181,7 @@ impl Evaluator {
                 ops.push(UnaryOp {
                     pre,
                     eff,
-                    cost: if unit { 1 } else { o.cost },
+                    cost: if plus_one { 1 + o.cost } else { o.cost },
                     op: Some(i as u32),
                 });
             }
@@ -212,7 +214,7 @@ impl Evaluator {
         let min_cost = task
             .operators
             .iter()
-            .map(|o| if unit { 1 } else { o.cost })
+            .map(|o| if plus_one { 1 + o.cost } else { o.cost })
             .min()
             .unwrap_or(0);
         let n = ops.len();
@@ -234,7 +236,7 @@ impl Evaluator {
             supporter: vec![u32::MAX; nf],
             unsat: vec![0; n],
             acc: vec![0; n],
-            heap: if unit || task.operators.iter().all(|o| o.cost <= 100) {
+            heap: if task.operators.iter().all(|o| o.cost <= 100) {
                 Queue::Buckets(Vec::new(), 0, 0)
             } else {
                 Queue::Heap(BinaryHeap::new())

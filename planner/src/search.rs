@@ -173,8 +173,8 @@ pub struct Search<'t> {
 
 impl<'t> Search<'t> {
     pub fn new(task: &'t Task, opts: Options) -> Search<'t> {
-        let unit = opts.algorithm == Algorithm::Gbfs;
-        let eval = Evaluator::new(task, opts.heuristic, unit);
+        let plus_one = opts.algorithm == Algorithm::Gbfs;
+        let eval = Evaluator::new(task, opts.heuristic, plus_one);
         Search {
             task,
             opts,
