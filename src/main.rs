@@ -3,6 +3,7 @@
 
 mod files;
 mod pddl_cmd;
+mod plan_cmd;
 mod report;
 mod rules_cmd;
 mod run_cmd;
@@ -148,6 +149,51 @@ enum Command {
         #[arg(long, value_enum, default_value_t)]
         format: Format,
     },
+    /// Find a plan for a PDDL problem (`sas_plan` format).
+    Plan {
+        domain: PathBuf,
+        problem: PathBuf,
+        /// Write the plan here (atomically) instead of to stdout.
+        #[arg(short = 'o', long = "output")]
+        output: Option<PathBuf>,
+        /// The search algorithm.
+        #[arg(long, value_enum, default_value_t = SearchArg::Gbfs)]
+        search: SearchArg,
+        /// The heuristic.
+        #[arg(long, value_enum, default_value_t = HeuristicArg::Ff)]
+        heuristic: HeuristicArg,
+        /// Give up after this many seconds.
+        #[arg(long, value_name = "S")]
+        timeout: Option<f64>,
+        /// Do not print search statistics on stderr.
+        #[arg(short, long)]
+        quiet: bool,
+        #[arg(long, value_enum, default_value_t)]
+        format: Format,
+    },
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum SearchArg {
+    /// Greedy best-first search (fast, not optimal).
+    Gbfs,
+    /// A* (optimal with `lmcut`, `max` or `blind`).
+    Astar,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum HeuristicArg {
+    /// FF: the cost of a relaxed plan (with preferred operators).
+    Ff,
+    /// The additive heuristic.
+    Add,
+    /// The max heuristic (admissible).
+    Max,
+    /// No guidance (admissible).
+    Blind,
+    /// LM-cut (admissible; h_max where the task has conditional effects or
+    /// derived predicates).
+    Lmcut,
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -172,6 +218,35 @@ impl From<EmitFormat> for btc_lang::emit::Format {
             EmitFormat::Commands => F::Commands,
         }
     }
+}
+
+fn plan_options(
+    search: SearchArg,
+    heuristic: HeuristicArg,
+    timeout: Option<f64>,
+) -> anyhow::Result<btc_planner::Options> {
+    use btc_planner::{Algorithm, Heuristic};
+    let timeout = match timeout {
+        Some(t) if !(t.is_finite() && t >= 0.0) => {
+            anyhow::bail!("`--timeout` must be a number of seconds of at least 0, not {t}")
+        }
+        Some(t) => Some(std::time::Duration::from_secs_f64(t.min(1e9))),
+        None => None,
+    };
+    Ok(btc_planner::Options {
+        algorithm: match search {
+            SearchArg::Gbfs => Algorithm::Gbfs,
+            SearchArg::Astar => Algorithm::Astar,
+        },
+        heuristic: match heuristic {
+            HeuristicArg::Ff => Heuristic::Ff,
+            HeuristicArg::Add => Heuristic::Add,
+            HeuristicArg::Max => Heuristic::Max,
+            HeuristicArg::Blind => Heuristic::Blind,
+            HeuristicArg::Lmcut => Heuristic::LmCut,
+        },
+        timeout,
+    })
 }
 
 fn main() -> ExitCode {
@@ -244,6 +319,25 @@ fn main() -> ExitCode {
             plan,
             format,
         } => validate_cmd::run(&domain, &problem, &plan, format),
+        Command::Plan {
+            domain,
+            problem,
+            output,
+            search,
+            heuristic,
+            timeout,
+            quiet,
+            format,
+        } => plan_options(search, heuristic, timeout).and_then(|options| {
+            plan_cmd::run(&plan_cmd::PlanArgs {
+                domain: &domain,
+                problem: &problem,
+                output: output.as_deref(),
+                options,
+                quiet,
+                format,
+            })
+        }),
     };
     match result {
         Ok(code) => code,

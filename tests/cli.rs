@@ -232,3 +232,54 @@ fn example_readmes_show_the_current_picture() {
     }
     assert!(checked >= 4);
 }
+
+/// `btc plan` writes a plan `btc validate` accepts, to stdout or atomically
+/// to `-o`; statistics go to stderr; the exit code says what happened.
+#[test]
+fn plan_writes_plans_that_validate() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_path = dir.path().join("sas_plan");
+    let (domain, problem) = ("examples/ariac/domain.pddl", "examples/ariac/problem.pddl");
+    let run = btc(&["plan", domain, problem, "-o", out_path.to_str().unwrap()]);
+    assert!(run.status.success(), "{run:?}");
+    assert!(run.stdout.is_empty());
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(stderr.contains("plan: 4 steps, cost 4;"), "{stderr}");
+    assert!(stderr.contains("expanded"), "{stderr}");
+    let text = std::fs::read_to_string(&out_path).unwrap();
+    assert!(text.ends_with("; cost = 4 (unit cost)\n"), "{text}");
+    let check = btc(&["validate", domain, problem, out_path.to_str().unwrap()]);
+    assert!(check.status.success(), "{check:?}");
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+
+    // Optimal search to stdout gives the same four steps.
+    let astar = btc(&[
+        "plan",
+        domain,
+        problem,
+        "--search",
+        "astar",
+        "--heuristic",
+        "max",
+    ]);
+    assert_eq!(String::from_utf8_lossy(&astar.stdout), text);
+
+    // JSON: the plan and the statistics in one document.
+    let json = btc(&["plan", domain, problem, "--format", "json"]);
+    let doc: serde_json::Value = serde_json::from_slice(&json.stdout).unwrap();
+    assert_eq!(doc["solved"], true);
+    assert_eq!(doc["plan"]["steps"], 4);
+    assert!(doc["statistics"]["expanded"].as_u64().unwrap() >= 4);
+
+    // Unsolvable: exit 1, no plan; a bad limit is a usage error (2).
+    let none = btc(&[
+        "plan",
+        "tests/fixtures/diagnostics/S003/domain.pddl",
+        "tests/fixtures/diagnostics/S003/problem.pddl",
+    ]);
+    assert_eq!(none.status.code(), Some(1));
+    assert!(none.stdout.is_empty());
+    assert!(String::from_utf8_lossy(&none.stderr).contains("no plan exists"));
+    let bad = btc(&["plan", domain, problem, "--timeout", "-1"]);
+    assert_eq!(bad.status.code(), Some(2));
+}

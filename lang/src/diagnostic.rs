@@ -213,6 +213,11 @@ pub mod codes {
         GOAL_NOT_REACHED = "V002", "a plan that does not reach the goal";
         COST_MISMATCH = "V003", "a plan whose stated cost differs from its computed cost";
         EFFECT_CONFLICT = "V004", "a numeric effect that cannot be computed";
+        // Planning
+        PLAN_UNSUPPORTED = "S001", "a PDDL feature the planner does not support";
+        PLAN_COST = "S002", "an action cost the planner cannot compute";
+        PLAN_UNSOLVABLE = "S003", "a goal that no plan reaches";
+        PLAN_TIMEOUT = "S004", "a search stopped by its time limit";
         // .btrules
         R_SYNTAX = "R001", "text that is not `.btrules` syntax";
         R_UNKNOWN_ACTION = "R002", "a rule for an action the domain does not have";

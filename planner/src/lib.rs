@@ -1,0 +1,262 @@
+//! The btc planner: grounds a PDDL problem of the `btc-lang` model (with
+//! reachability pruning) and searches it with greedy best-first search or
+//! A* under h_FF, h_add, h_max or the blind heuristic.
+//!
+//! [`plan`] plans from a problem's `:init`; [`plan_from`] from any state of
+//! the problem's objects (a runtime's knowledge base) to any goal, which is
+//! what replanning needs. Nothing here prints.
+//!
+//! ```
+//! use btc_lang::pipeline::{domain_unit_from, problem_unit_from};
+//! use btc_lang::state::World;
+//! use btc_planner::{plan_from, to_sas_plan, Options, Outcome};
+//!
+//! let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/ariac/");
+//! let read = |f: &str| std::fs::read_to_string(format!("{dir}{f}")).unwrap();
+//! let du = domain_unit_from(&read("domain.pddl"), 0);
+//! let domain = du.domain.as_ref().unwrap();
+//! let pu = problem_unit_from(&read("problem.pddl"), 1, Some(domain), &du.index);
+//! let problem = pu.problem.as_ref().unwrap();
+//!
+//! // A knowledge base: the problem's facts, then what execution changed.
+//! let mut kb = World::new(domain, &du.index, &pu.index).initial_state(problem);
+//! let key = |pred: &str, args: &[&str]| -> Box<[u32]> {
+//!     let mut k = vec![du.index.predicates[pred].index as u32];
+//!     k.extend(args.iter().map(|a| pu.index.objects[*a].id));
+//!     k.into()
+//! };
+//! kb.facts.remove(&key("is_reachable", &["floor_robot", "curr_position"]));
+//! kb.facts.insert(key("is_reachable", &["floor_robot", "bin1"]));
+//!
+//! let report = plan_from(domain, &du.index, &pu.index, &kb, problem.goal.as_ref(),
+//!                        &Options::default()).unwrap();
+//! let Outcome::Plan(plan) = report.outcome else { panic!("no plan") };
+//! assert_eq!(plan.steps.len(), 3); // grasp, move, place
+//! print!("{}", to_sas_plan(domain, &pu.index, &plan));
+//! ```
+
+pub mod ground;
+pub mod heuristic;
+pub mod improve;
+pub mod lifted;
+pub mod lmcut;
+pub mod search;
+pub mod task;
+
+pub use ground::GroundStats;
+pub use heuristic::Heuristic;
+pub use search::{Algorithm, Options, SearchStats};
+
+use btc_lang::diagnostic::{codes, Diagnostic};
+use btc_lang::pddl::ast::{Domain, Formula, InitFact, Problem};
+use btc_lang::pddl::check::{DomainIndex, ProblemIndex};
+use btc_lang::state::{State, World};
+use std::time::{Duration, Instant};
+
+/// One step of a plan: an action of the domain and its arguments (object
+/// ids of the problem index).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Step {
+    pub action: usize,
+    pub args: Vec<u32>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Plan {
+    pub steps: Vec<Step>,
+    /// The sum of the step costs (`total-cost` increases, or 1 per step
+    /// when the domain has no `total-cost`).
+    pub cost: u64,
+    /// `total-cost` before the first step.
+    pub base_cost: f64,
+    /// Whether every action costs 1.
+    pub unit_cost: bool,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Outcome {
+    Plan(Plan),
+    /// No plan exists (the search space is exhausted).
+    Unsolvable,
+    /// The time limit stopped the search.
+    Timeout,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Report {
+    pub outcome: Outcome,
+    pub ground: GroundStats,
+    pub ground_time: Duration,
+    pub search: SearchStats,
+}
+
+/// Plans from the problem's initial state to its goal.
+pub fn plan(
+    domain: &Domain,
+    dix: &DomainIndex,
+    problem: &Problem,
+    pix: &ProblemIndex,
+    opts: &Options,
+) -> Result<Report, Vec<Diagnostic>> {
+    let world = World::new(domain, dix, pix);
+    // The facts and values of `:init`; derived atoms are the planner's job.
+    let mut init = State::default();
+    let env = Vec::new();
+    for f in &problem.init {
+        match f {
+            InitFact::Atom { atom } => init.facts.extend(world.atom_key(atom, &env)),
+            InitFact::Value { fluent, value, .. } => {
+                if let Some(k) = world.fluent_key(fluent, &env) {
+                    init.fluents.insert(k, *value);
+                }
+            }
+        }
+    }
+    plan_from(domain, dix, pix, &init, problem.goal.as_ref(), opts)
+}
+
+/// Plans from `initial` (facts and numeric values over the problem's
+/// objects; derived atoms are recomputed) to `goal` (`None`: already
+/// reached).
+pub fn plan_from(
+    domain: &Domain,
+    dix: &DomainIndex,
+    pix: &ProblemIndex,
+    initial: &State,
+    goal: Option<&Formula>,
+    opts: &Options,
+) -> Result<Report, Vec<Diagnostic>> {
+    let t0 = Instant::now();
+    let deadline = opts.timeout.map(|t| t0 + t);
+    let Some((task, ground)) = ground::ground(domain, dix, pix, initial, goal, deadline)? else {
+        return Ok(Report {
+            outcome: Outcome::Timeout,
+            ground: GroundStats::default(),
+            ground_time: t0.elapsed(),
+            search: SearchStats::default(),
+        });
+    };
+    let ground_time = t0.elapsed();
+    let mut opts = *opts;
+    if let Some(t) = opts.timeout {
+        opts.timeout = Some(t.saturating_sub(ground_time));
+    }
+    let mut s = search::Search::new(&task, opts);
+    let result = s.run();
+    let outcome = match result {
+        search::SearchResult::Plan(mut ops, mut cost) => {
+            if opts.algorithm == Algorithm::Gbfs {
+                ops = improve::eliminate_redundant(&task, ops);
+                cost = ops.iter().map(|&o| task.operators[o as usize].cost).sum();
+            }
+            Outcome::Plan(Plan {
+                steps: ops
+                    .iter()
+                    .map(|&o| {
+                        let op = &task.operators[o as usize];
+                        Step {
+                            action: op.action,
+                            args: op.args.clone(),
+                        }
+                    })
+                    .collect(),
+                cost,
+                base_cost: task.base_cost,
+                unit_cost: task.unit_cost,
+            })
+        }
+        search::SearchResult::Unsolvable => Outcome::Unsolvable,
+        search::SearchResult::Timeout => Outcome::Timeout,
+    };
+    Ok(Report {
+        outcome,
+        ground,
+        ground_time,
+        search: s.stats,
+    })
+}
+
+/// The plan in Fast Downward's `sas_plan` format: one `(action args)` per
+/// line, then `; cost = N (unit cost|general cost)`.
+pub fn to_sas_plan(domain: &Domain, pix: &ProblemIndex, plan: &Plan) -> String {
+    let mut out = String::new();
+    for s in &plan.steps {
+        out.push('(');
+        out.push_str(&domain.actions[s.action].name.name);
+        for &a in &s.args {
+            out.push(' ');
+            out.push_str(&pix.object_names[a as usize]);
+        }
+        out.push_str(")\n");
+    }
+    let total = plan.base_cost + plan.cost as f64;
+    out.push_str(&format!(
+        "; cost = {} ({})\n",
+        total,
+        if plan.unit_cost {
+            "unit cost"
+        } else {
+            "general cost"
+        }
+    ));
+    out
+}
+
+/// The diagnostic for a goal no plan reaches.
+pub fn unsolvable(problem: &Problem) -> Diagnostic {
+    let span = problem.goal.as_ref().map_or(problem.span, Formula::span);
+    Diagnostic::error(
+        codes::PLAN_UNSOLVABLE,
+        span,
+        "no plan reaches this goal from the initial state",
+    )
+    .with_hint("every reachable state was searched; check the goal and the `:init` facts")
+}
+
+/// The diagnostic for a search stopped by its time limit.
+pub fn timeout(problem: &Problem, limit: Duration) -> Diagnostic {
+    Diagnostic::error(
+        codes::PLAN_TIMEOUT,
+        problem.name.span,
+        format!(
+            "no plan found within the time limit of {} s",
+            limit.as_secs_f64()
+        ),
+    )
+    .with_hint("raise `--timeout`, or try `--search gbfs --heuristic ff`")
+}
+
+#[cfg(test)]
+pub(crate) mod test_util {
+    use btc_lang::pipeline::{domain_unit_from, problem_unit_from};
+    use btc_lang::state::World;
+
+    /// The ground task of a domain and problem text (fixtures from
+    /// `tests/fixtures/`).
+    pub fn task(domain: &str, problem: &str) -> crate::task::Task {
+        let du = domain_unit_from(domain, 0);
+        let d = du.domain.as_ref().expect("domain parses");
+        let pu = problem_unit_from(problem, 1, Some(d), &du.index);
+        let p = pu.problem.as_ref().expect("problem parses");
+        let world = World::new(d, &du.index, &pu.index);
+        let init = world.initial_state(p);
+        crate::ground::ground(d, &du.index, &pu.index, &init, p.goal.as_ref(), None)
+            .expect("grounds")
+            .expect("no time limit")
+            .0
+    }
+
+    pub fn rooms() -> crate::task::Task {
+        task(
+            include_str!("../tests/fixtures/rooms-domain.pddl"),
+            include_str!("../tests/fixtures/rooms-problem.pddl"),
+        )
+    }
+
+    pub fn fact(t: &crate::task::Task, name: &str) -> u32 {
+        t.fact_names
+            .iter()
+            .position(|n| n == name)
+            .unwrap_or_else(|| panic!("no fact {name}")) as u32
+    }
+}

@@ -1,0 +1,128 @@
+//! `btc plan DOMAIN PROBLEM`: ground and search; the plan goes to stdout
+//! (or atomically to `-o`), statistics to stderr.
+
+use crate::{files, report, Format};
+use btc_lang::diagnostic::has_errors;
+use btc_lang::pipeline::{domain_unit, problem_unit};
+use btc_lang::source::Sources;
+use btc_planner::{Heuristic, Options, Outcome};
+use std::path::Path;
+use std::process::ExitCode;
+
+pub struct PlanArgs<'a> {
+    pub domain: &'a Path,
+    pub problem: &'a Path,
+    pub output: Option<&'a Path>,
+    pub options: Options,
+    pub quiet: bool,
+    pub format: Format,
+}
+
+pub fn run(args: &PlanArgs) -> anyhow::Result<ExitCode> {
+    let mut sources = Sources::new();
+    let mut diags = Vec::new();
+    let d = files::load(&mut sources, args.domain, &mut diags)?;
+    let p = files::load(&mut sources, args.problem, &mut diags)?;
+    let du = domain_unit(&sources, d);
+    let pu = problem_unit(&sources, p, &du);
+    diags.extend(du.diagnostics.iter().cloned());
+    diags.extend(pu.diagnostics.iter().cloned());
+    let (Some(domain), Some(problem)) = (&du.domain, &pu.problem) else {
+        return finish(&diags, &sources, args.format, None);
+    };
+    if has_errors(&diags) {
+        return finish(&diags, &sources, args.format, None);
+    }
+    let report = match btc_planner::plan(domain, &du.index, problem, &pu.index, &args.options) {
+        Ok(r) => r,
+        Err(ds) => {
+            diags.extend(ds);
+            return finish(&diags, &sources, args.format, None);
+        }
+    };
+    let stats = serde_json::json!({
+        "heuristic": report.search.heuristic.map(|h| format!("{h:?}").to_lowercase()),
+        "reachable_atoms": report.ground.reachable_atoms,
+        "operators": report.ground.operators,
+        "axioms": report.ground.axioms,
+        "facts": report.ground.facts,
+        "ground_ms": report.ground_time.as_secs_f64() * 1e3,
+        "expanded": report.search.expanded,
+        "generated": report.search.generated,
+        "evaluated": report.search.evaluated,
+        "search_ms": report.search.time.as_secs_f64() * 1e3,
+    });
+    let mut plan_json = None;
+    match &report.outcome {
+        Outcome::Plan(plan) => {
+            let text = btc_planner::to_sas_plan(domain, &pu.index, plan);
+            match args.output {
+                Some(path) => files::write_atomically(path, &text)?,
+                None if args.format == Format::Text => print!("{text}"),
+                None => {}
+            }
+            plan_json = Some(serde_json::json!({
+                "steps": plan.steps.len(),
+                "cost": plan.base_cost + plan.cost as f64,
+                "plan": text,
+            }));
+        }
+        Outcome::Unsolvable => diags.push(btc_planner::unsolvable(problem)),
+        Outcome::Timeout => diags.push(btc_planner::timeout(
+            problem,
+            args.options.timeout.unwrap_or_default(),
+        )),
+    }
+    if args.format == Format::Text && !args.quiet {
+        let r = &report;
+        if args.options.heuristic == Heuristic::LmCut && r.search.heuristic == Some(Heuristic::Max)
+        {
+            eprintln!("note: LM-cut needs a task without conditional effects and derived predicates; h_max was used");
+        }
+        let found = match &r.outcome {
+            Outcome::Plan(p) => format!(
+                "plan: {}, cost {}",
+                report::plural(p.steps.len(), "step"),
+                p.base_cost + p.cost as f64
+            ),
+            Outcome::Unsolvable => "no plan exists".to_owned(),
+            Outcome::Timeout => "time limit reached".to_owned(),
+        };
+        eprintln!(
+            "{found}; {} ground actions, {} facts, {} axioms; {} expanded, {} generated; grounding {:.3} ms, search {:.3} ms",
+            r.ground.operators,
+            r.ground.facts,
+            r.ground.axioms,
+            r.search.expanded,
+            r.search.generated,
+            r.ground_time.as_secs_f64() * 1e3,
+            r.search.time.as_secs_f64() * 1e3,
+        );
+    }
+    finish(&diags, &sources, args.format, Some((stats, plan_json)))
+}
+
+fn finish(
+    diags: &[btc_lang::diagnostic::Diagnostic],
+    sources: &Sources,
+    format: Format,
+    result: Option<(serde_json::Value, Option<serde_json::Value>)>,
+) -> anyhow::Result<ExitCode> {
+    let json = report::diagnostics(diags, sources, format);
+    let solved = result.as_ref().is_some_and(|(_, p)| p.is_some()) && !has_errors(diags);
+    if format == Format::Json {
+        let (stats, plan) = result.unwrap_or((serde_json::Value::Null, None));
+        let doc = serde_json::json!({
+            "solved": solved,
+            "plan": plan,
+            "statistics": stats,
+            "diagnostics": json,
+        });
+        println!("{}", serde_json::to_string_pretty(&doc)?);
+    }
+    Ok(if solved {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
+}
