@@ -44,12 +44,12 @@ vim.api.nvim_create_autocmd('FileType', {
   end,
 })
 
--- Useful mappings once the server is attached (all built in from 0.8):
---   K                      hover (a node's ports, a variable's PDDL types)
---   gd / <C-]>             vim.lsp.buf.definition()
---   vim.lsp.buf.references(), vim.lsp.buf.rename(), vim.lsp.buf.code_action()
---   vim.lsp.buf.format()   the `btc fmt` layout
---   vim.diagnostic.open_float(), [d / ]d (0.10) or vim.diagnostic.goto_next()
+-- Once the server is attached, Neovim (0.8) sets omnifunc (completion with
+-- <C-x><C-o>), tagfunc (<C-]> goes to the definition) and formatexpr (gq).
+-- Neovim 0.10 maps K to hover; 0.11 adds grn (rename), gra (code action),
+-- grr (references). Otherwise call vim.lsp.buf.hover(), .definition(),
+-- .references(), .rename(), .code_action(), .format() (the `btc fmt` layout)
+-- and vim.diagnostic.open_float() from mappings of your own.
 
 -- Variant 2: nvim-lspconfig ------------------------------------------------
 --
