@@ -5,7 +5,7 @@
 'use strict';
 
 const vscode = require('vscode');
-const { LanguageClient, TransportKind } = require('vscode-languageclient/node');
+const { LanguageClient } = require('vscode-languageclient/node');
 
 /** @type {LanguageClient | undefined} */
 let client;
@@ -22,9 +22,11 @@ function serverPath() {
 function createClient() {
   const command = serverPath();
   /** @type {import('vscode-languageclient/node').ServerOptions} */
+  // stdio, but no `transport` field: with `TransportKind.stdio` the client
+  // would append `--stdio` to the arguments, which `btc lsp` refuses.
   const serverOptions = {
-    run: { command, args: ['lsp'], transport: TransportKind.stdio },
-    debug: { command, args: ['lsp'], transport: TransportKind.stdio },
+    run: { command, args: ['lsp'] },
+    debug: { command, args: ['lsp'] },
   };
   /** @type {import('vscode-languageclient/node').LanguageClientOptions} */
   const clientOptions = {
@@ -46,8 +48,8 @@ function createClient() {
 }
 
 async function startClient() {
-  client = createClient();
   try {
+    client = createClient();
     await client.start();
   } catch (err) {
     const message = err instanceof Error ? err.message : String(err);
