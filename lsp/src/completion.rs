@@ -7,8 +7,8 @@ use btc_lang::db::STDLIB;
 use btc_lang::rules::ast::{Item, NodeKind, PortDecl};
 use btc_lang::rules::lexer::Tok;
 use tower_lsp::lsp_types::{
-    CompletionItem, CompletionItemKind, InsertTextFormat, ParameterInformation, ParameterLabel,
-    SignatureHelp, SignatureInformation,
+    CompletionItem, CompletionItemKind, CompletionTextEdit, InsertTextFormat, ParameterInformation,
+    ParameterLabel, SignatureHelp, SignatureInformation, TextEdit,
 };
 
 const BASIC_TYPES: &[&str] = &["string", "int", "float", "bool"];
@@ -232,13 +232,21 @@ pub fn completion(a: &Analysis, offset: usize) -> Vec<CompletionItem> {
     match context(a, offset) {
         Context::Variable => {
             out = variables(a, offset);
-            // The client replaces the word it sees; without `?` in it, the
-            // inserted text must not repeat the `?` already typed.
-            let before = a.text.get(..offset).unwrap_or_default();
-            if before.ends_with('?') {
-                for c in &mut out {
-                    c.insert_text = Some(c.label.trim_start_matches('?').to_owned());
-                }
+            // Replace the whole `?name` typed so far: clients that do not
+            // count `?` as part of a word would otherwise insert `??name`.
+            let t = &a.syntax.tokens;
+            let c = cursor(a, offset);
+            let start = match c.prefix.map(|p| &t.toks[p]) {
+                Some((Tok::Var(_), s)) => s.start as usize,
+                _ => offset.saturating_sub(1),
+            };
+            let ix = a.line_index();
+            let range = tower_lsp::lsp_types::Range::new(ix.position(start), ix.position(offset));
+            for c in &mut out {
+                c.text_edit = Some(CompletionTextEdit::Edit(TextEdit::new(
+                    range,
+                    c.label.clone(),
+                )));
             }
         }
         Context::Predicate => {

@@ -298,6 +298,13 @@ async fn completion_knows_its_context() {
 
     let vars = labels(&mut c, &u, line(2), 16).await;
     assert_eq!(vars, ["?robot", "?part", "?c"]);
+    // Each replaces the `?` typed already, whatever the client counts as a word.
+    let r = c.at("textDocument/completion", &u, line(2), 18).await;
+    assert_eq!(
+        r[0]["textEdit"]["range"],
+        json!({ "start": { "line": line(2), "character": 16 }, "end": { "line": line(2), "character": 18 } })
+    );
+    assert_eq!(r[0]["textEdit"]["newText"], "?robot");
 
     let template = labels(&mut c, &u, line(5), 4).await;
     assert!(
