@@ -531,3 +531,28 @@ async fn a_domain_changed_on_disk_rechecks_the_rules_that_use_it() {
     assert_eq!(codes(&diags), ["R002"], "{diags:#?}");
     assert!(diags[0]["message"].as_str().unwrap().contains("grasp"));
 }
+
+#[tokio::test]
+async fn a_domain_edited_in_the_editor_rechecks_the_rules_and_reports_its_own_errors() {
+    let mut c = TestClient::new().await;
+    let u = c.open(&ariac()).await;
+    assert!(c.diagnostics_for(&u).await.is_empty());
+    let domain = repo().join("examples/ariac/domain.pddl");
+    let ud = url::Url::from_file_path(&domain).unwrap();
+    assert_eq!(codes(&c.diagnostics_for(&ud).await), ["P108"]);
+    let text = text_of(&domain).replace("(:action place", "(:action put");
+    let ud = c.open_text(&domain, &text).await;
+    // The rules now name an action the domain lacks...
+    let diags = c.diagnostics_for(&u).await;
+    assert_eq!(codes(&diags), ["R002"], "{diags:#?}");
+    // ... and the domain gets its own warning and the action no rule covers.
+    let dd = c.diagnostics_for(&ud).await;
+    assert_eq!(codes(&dd), ["R012", "P108"]);
+    // Undoing the edit clears the rules file again.
+    c.notify(
+        "textDocument/didChange",
+        json!({ "textDocument": { "uri": ud, "version": 2 }, "contentChanges": [{ "text": text_of(&domain) }] }),
+    )
+    .await;
+    assert!(c.diagnostics_for(&u).await.is_empty());
+}

@@ -16,6 +16,8 @@ use tower_lsp::LspService;
 pub struct TestClient {
     service: LspService<btc_lsp::server::Backend>,
     diagnostics: mpsc::UnboundedReceiver<Value>,
+    /// Batches received for other files while waiting for one.
+    pending: Vec<Value>,
     next_id: i64,
 }
 
@@ -52,6 +54,7 @@ impl TestClient {
         let mut c = TestClient {
             service,
             diagnostics: rx,
+            pending: Vec::new(),
             next_id: 0,
         };
         let r = c.request("initialize", json!({ "capabilities": {} })).await;
@@ -124,8 +127,13 @@ impl TestClient {
     }
 
     /// The next batch of diagnostics published for `u` (every change
-    /// publishes one batch per affected file).
+    /// publishes one batch per affected file); batches for other files
+    /// wait for their turn.
     pub async fn diagnostics_for(&mut self, u: &Url) -> Vec<Value> {
+        if let Some(i) = self.pending.iter().position(|b| b["uri"] == json!(u)) {
+            let b = self.pending.remove(i);
+            return b["diagnostics"].as_array().cloned().unwrap_or_default();
+        }
         loop {
             let next =
                 tokio::time::timeout(std::time::Duration::from_secs(10), self.diagnostics.recv())
@@ -135,12 +143,14 @@ impl TestClient {
             if next["uri"] == json!(u) {
                 return next["diagnostics"].as_array().cloned().unwrap_or_default();
             }
+            self.pending.push(next);
         }
     }
 
     /// Drops whatever diagnostics were published so far.
     pub fn drain(&mut self) -> usize {
-        let mut n = 0;
+        let mut n = self.pending.len();
+        self.pending.clear();
         while self.diagnostics.try_recv().is_ok() {
             n += 1;
         }
