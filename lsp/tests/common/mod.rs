@@ -16,7 +16,7 @@ use tower_lsp::LspService;
 pub struct TestClient {
     service: LspService<btc_lsp::server::Backend>,
     diagnostics: mpsc::UnboundedReceiver<Value>,
-    /// Batches received for other files while waiting for one.
+    /// The newest batch received for each other file while waiting for one.
     pending: Vec<Value>,
     next_id: i64,
 }
@@ -127,8 +127,8 @@ impl TestClient {
     }
 
     /// The next batch of diagnostics published for `u` (every change
-    /// publishes one batch per affected file); batches for other files
-    /// wait for their turn.
+    /// publishes one batch per affected file); the newest batch of each
+    /// other file waits for its turn.
     pub async fn diagnostics_for(&mut self, u: &Url) -> Vec<Value> {
         if let Some(i) = self.pending.iter().position(|b| b["uri"] == json!(u)) {
             let b = self.pending.remove(i);
@@ -143,6 +143,7 @@ impl TestClient {
             if next["uri"] == json!(u) {
                 return next["diagnostics"].as_array().cloned().unwrap_or_default();
             }
+            self.pending.retain(|b| b["uri"] != next["uri"]);
             self.pending.push(next);
         }
     }
