@@ -283,3 +283,32 @@ fn plan_writes_plans_that_validate() {
     let bad = btc(&["plan", domain, problem, "--timeout", "-1"]);
     assert_eq!(bad.status.code(), Some(2));
 }
+
+#[test]
+fn json_diagnostics_carry_their_fixes() {
+    let out = btc(&[
+        "check",
+        "tests/fixtures/diagnostics/R007/rules.btrules",
+        "--format",
+        "json",
+    ]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let d = v["diagnostics"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|d| d["code"] == "R007")
+        .unwrap();
+    let fix = &d["fixes"][0];
+    assert_eq!(fix["replacement"], "MoveTo");
+    assert_eq!(fix["start"], d["start"]);
+    assert_eq!(fix["end"], d["end"]);
+    // Diagnostics without a fix have no `fixes` key at all.
+    let r014 = v["diagnostics"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|d| d["code"] == "R014")
+        .unwrap();
+    assert!(r014.get("fixes").is_none());
+}

@@ -109,6 +109,19 @@ pub struct JsonDiagnostic {
     pub end: Position,
     pub hint: Option<String>,
     pub labels: Vec<JsonLabel>,
+    /// Machine-applicable repairs (what the language server's quick fixes
+    /// apply): replace `start`..`end` of `file` with `replacement`.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub fixes: Vec<JsonFix>,
+}
+
+#[derive(Serialize)]
+pub struct JsonFix {
+    pub title: String,
+    pub file: String,
+    pub start: Position,
+    pub end: Position,
+    pub replacement: String,
 }
 
 fn position(sources: &Sources, file: FileId, offset: u32) -> Position {
@@ -138,6 +151,17 @@ pub fn to_json(d: &Diagnostic, sources: &Sources) -> JsonDiagnostic {
                 start: position(sources, l.span.file, l.span.start),
                 end: position(sources, l.span.file, l.span.end),
                 message: l.message.clone(),
+            })
+            .collect(),
+        fixes: d
+            .fixes
+            .iter()
+            .map(|x| JsonFix {
+                title: x.title.clone(),
+                file: sources.get(x.span.file).path.clone(),
+                start: position(sources, x.span.file, x.span.start),
+                end: position(sources, x.span.file, x.span.end),
+                replacement: x.replacement.clone(),
             })
             .collect(),
     }
