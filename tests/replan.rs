@@ -204,6 +204,8 @@ fn insufficient_parts_text_report_names_the_literal_and_exits_1() {
 fn a_high_priority_order_whose_effect_applies_needs_no_replan() {
     let (code, s) = replan("problem.pddl", Some("high_priority_order"), &[]);
     assert_recovered(&s, code, 0);
+    // The order's goal is part of the final goal check.
+    assert_eq!(s["goal"], "(and (on battery_red agv1) (on pump_red agv2))");
 }
 
 #[test]
@@ -296,5 +298,14 @@ fn without_replan_the_same_scenarios_fail() {
             &format!("examples/ariac/faults/{sc}.toml"),
         ]);
         assert_eq!(out.status.code(), Some(1), "{sc}");
+    }
+}
+
+#[test]
+fn pauses_and_blackouts_are_absorbed_by_the_tree_without_replans() {
+    for sc in ["human_too_close", "sensor_blackout"] {
+        let (code, s) = replan("problem.pddl", Some(sc), &[]);
+        assert_recovered(&s, code, 0);
+        assert!(s["ticks"].as_u64().unwrap() > 5, "{sc}: {s:#}");
     }
 }

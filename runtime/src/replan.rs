@@ -357,7 +357,9 @@ pub fn run_loop(
         }
         let discarded = engine.discarded_parts();
         let kb = engine.kb.as_mut().expect("built with a KB");
-        let added = kb.extra_goal_texts();
+        let mut added = kb.extra_goal_texts();
+        added.retain(|a| !carry.extra_goals.contains(a));
+        carry.extra_goals.extend(added.iter().cloned());
         let (goal_ok, goal_why) = kb.goal();
         carry.state = Some(std::mem::take(&mut kb.state));
         carry.tick = engine.tick;
@@ -419,10 +421,7 @@ pub fn run_loop(
         // The goal adjustments: orders that added a goal, parts replaced.
         let mut adjustments = Vec::new();
         for a in added {
-            if !carry.extra_goals.contains(&a) {
-                adjustments.push(format!("a fault added the goal `{a}`"));
-                carry.extra_goals.push(a);
-            }
+            adjustments.push(format!("a fault added the goal `{a}`"));
         }
         {
             let w = world(db, job)?;
