@@ -127,7 +127,8 @@ pub enum PlanInput<'a> {
     /// A plan file on disk.
     File(&'a Path),
     /// A plan that does not exist yet (the closed loop plans it): an empty
-    /// file under this name; diagnostics about it are left out.
+    /// file under this name; the plan reader's diagnostics about it (L006,
+    /// no steps) are left out.
     Planned(&'a str),
 }
 
@@ -166,7 +167,7 @@ pub fn load_job_with(
     diags.extend(
         db::job_diagnostics(&database, job)
             .iter()
-            .filter(|d| Some(d.span.file) != planned)
+            .filter(|d| Some(d.span.file) != planned || !d.code.starts_with('L'))
             .cloned(),
     );
     Ok((database, job))

@@ -309,3 +309,20 @@ fn pauses_and_blackouts_are_absorbed_by_the_tree_without_replans() {
         assert!(s["ticks"].as_u64().unwrap() > 5, "{sc}: {s:#}");
     }
 }
+
+#[test]
+fn replanning_without_a_problem_is_refused_with_r017() {
+    let dir = tempfile::tempdir().unwrap();
+    for f in ["rules.btrules", "domain.pddl"] {
+        std::fs::copy(
+            format!("{}/examples/ariac/{f}", env!("CARGO_MANIFEST_DIR")),
+            dir.path().join(f),
+        )
+        .unwrap();
+    }
+    let rules = dir.path().join("rules.btrules");
+    let out = btc(&["run", rules.to_str().unwrap(), "--replan"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("R017"), "{err}");
+}
