@@ -382,7 +382,7 @@ fn run_replan(a: &RunArgs, rules: &Path) -> anyhow::Result<ExitCode> {
 }
 
 fn print_loop(s: &btc_runtime::LoopSummary) {
-    for (k, at) in s.attempts.iter().enumerate() {
+    for at in &s.attempts {
         let how = if at.source == "given" {
             "the given plan".to_owned()
         } else {
@@ -402,7 +402,11 @@ fn print_loop(s: &btc_runtime::LoopSummary) {
         }
         println!(
             "  {} at tick {} (ticks {}-{}); {} of {} plan steps done",
-            at.status.name(),
+            if at.preempted {
+                "PREEMPTED"
+            } else {
+                at.status.name()
+            },
             at.end_tick,
             at.start_tick + 1,
             at.end_tick,
@@ -425,13 +429,21 @@ fn print_loop(s: &btc_runtime::LoopSummary) {
                 r.tick, r.node_name, r.node_id, r.reason
             );
         }
+        if at.status == btc_runtime::Status::Success && !at.preempted && at.goal != s.goal {
+            println!("  the priority order is done; planning for the whole goal");
+        }
         if at.waited_ticks > 0 {
             println!(
                 "  waited {} for the faults in effect to end",
                 report::plural(at.waited_ticks as usize, "tick")
             );
         }
-        if let Some(rp) = s.replans.get(k) {
+        if let Some((k, rp)) = s
+            .replans
+            .iter()
+            .enumerate()
+            .find(|(_, r)| r.after_attempt == at.attempt)
+        {
             let from = match (&rp.from_step, &rp.action) {
                 (Some(_), Some(a)) => format!(" from {a}"),
                 _ => String::new(),

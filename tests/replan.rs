@@ -58,8 +58,15 @@ fn assert_recovered(s: &Value, code: i32, replans: usize) {
     assert_eq!(s["ok"], true);
     assert_eq!(s["goal_reached"], true, "{s:#}");
     assert_eq!(s["replans"].as_array().unwrap().len(), replans, "{s:#}");
-    assert_eq!(s["attempts"].as_array().unwrap().len(), replans + 1);
-    let last = s["attempts"].as_array().unwrap().last().unwrap();
+    // Every attempt but the last ended in a replan, or reached a priority
+    // order's goal (then the whole goal is planned for).
+    let attempts = s["attempts"].as_array().unwrap();
+    let orders_done = attempts[..attempts.len() - 1]
+        .iter()
+        .filter(|a| a["status"] == "SUCCESS")
+        .count();
+    assert_eq!(attempts.len(), replans + 1 + orders_done, "{s:#}");
+    let last = attempts.last().unwrap();
     assert_eq!(last["status"], "SUCCESS");
     assert_eq!(last["steps_done"], last["steps_total"]);
     for f in s["faults"].as_array().unwrap() {
@@ -209,23 +216,37 @@ fn a_high_priority_order_whose_effect_applies_needs_no_replan() {
 }
 
 #[test]
-fn a_high_priority_order_adds_its_goal_and_the_robot_fulfils_it() {
+fn a_high_priority_order_preempts_the_plan_and_is_done_first() {
     let (code, s) = replan("problem.pddl", Some("priority_order"), &[]);
     assert_recovered(&s, code, 1);
     assert_eq!(s["goal"], "(and (on battery_red agv1) (on pump_red agv2))");
+    // The order arrives at tick 2 and halts the first plan; the robot is
+    // preempted for 2 ticks, then the order is planned for on its own.
+    let first = &s["attempts"][0];
+    assert_eq!(first["preempted"], true);
+    assert_eq!(first["end_tick"], 2);
+    assert_eq!(first["waited_ticks"], 2);
+    let rp = &s["replans"][0];
+    assert!(rp["why"].as_str().unwrap().contains("preempted"), "{rp}");
+    assert_eq!(rp["faults"][0], "high_priority_order");
     assert_eq!(
-        s["replans"][0]["adjustments"][0],
+        rp["adjustments"][0],
         "a fault added the goal `(on pump_red agv2)`"
     );
+    assert_eq!(s["attempts"][1]["goal"], "(on pump_red agv2)");
     assert_eq!(
         plan(&s, 1),
         [
-            "(move floor_robot agv1 bin1)",
+            "(move floor_robot curr_position bin1)",
             "(grasp floor_robot pump_red bin1)",
             "(move floor_robot bin1 agv2)",
             "(place floor_robot pump_red agv2)",
         ]
     );
+    // Then the regular order, from agv2.
+    assert_eq!(s["attempts"][2]["goal"], s["goal"]);
+    assert_eq!(plan(&s, 2)[0], "(move floor_robot agv2 bin1)");
+    assert_eq!(plan(&s, 2)[3], "(place floor_robot battery_red agv1)");
 }
 
 #[test]

@@ -78,6 +78,15 @@ impl<'w> Kb<'w> {
             .collect()
     }
 
+    /// The goals added while running that do not hold, as their texts.
+    pub fn unmet_extra_goals(&self) -> Vec<String> {
+        self.extra_goals
+            .iter()
+            .filter(|&&f| !self.holds(f))
+            .filter_map(|&f| self.formula_text(f).map(str::to_owned))
+            .collect()
+    }
+
     /// Makes `f` the goal instead of the problem's (added goals still count).
     pub fn set_goal(&mut self, f: FormulaId) {
         self.goal_override = Some(f);

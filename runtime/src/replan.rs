@@ -71,6 +71,8 @@ pub struct Attempt {
     pub records: Vec<FaultRecord>,
     /// Ticks waited after the failure for faults with a duration to end.
     pub waited_ticks: u64,
+    /// A high-priority order halted the tree (its status is then RUNNING).
+    pub preempted: bool,
 }
 
 /// Why the loop planned again, and what changed.
@@ -149,6 +151,9 @@ struct Carry {
     extra_goals: Vec<String>,
     /// Parts in the goal replaced by spares: (part, spare).
     substitutions: Vec<(String, String)>,
+    /// Goals of high-priority orders that preempted a plan, to be reached
+    /// before the rest of the goal.
+    priority: Vec<String>,
 }
 
 /// Runs the loop on a compile job whose plan file is `job.plan`: with
@@ -184,6 +189,7 @@ pub fn run_loop(
         tick: 0,
         extra_goals: Vec::new(),
         substitutions: Vec::new(),
+        priority: Vec::new(),
     };
     let mut out = LoopSummary {
         attempts: Vec::new(),
@@ -202,8 +208,14 @@ pub fn run_loop(
     let trace = opts.engine.trace;
     loop {
         let attempt = out.attempts.len() + 1;
-        let goal_text = goal_text(&base_goal, &carry);
-        out.goal = goal_text.clone();
+        out.goal = goal_text(&base_goal, &carry);
+        // This attempt's goal: a priority order's first, then the whole.
+        let for_priority = !carry.priority.is_empty();
+        let goal_text = if for_priority {
+            priority_text(&carry)
+        } else {
+            out.goal.clone()
+        };
         // Plan (unless the first plan is given) from the carried state.
         let (plan_text, planning_ms, expanded) = if attempt == 1 && given_plan {
             (None, 0.0, 0)
@@ -213,7 +225,12 @@ pub fn run_loop(
             let g = goal_formula(&mut kb, &goal_text)?;
             kb.set_goal(g);
             if let (true, _) = kb.goal() {
-                // Nothing left to do (e.g. the order's effect applied).
+                if for_priority {
+                    // The order is done (e.g. by its own effect).
+                    carry.priority.clear();
+                    continue;
+                }
+                // Nothing left to do.
                 out.goal_reached = true;
                 out.goal_failure = None;
                 break;
@@ -341,16 +358,37 @@ pub fn run_loop(
         }
         let start_tick = engine.tick;
         let tr = Instant::now();
-        let status = engine.run(opts.max_ticks, |_| {});
+        // A high-priority order whose goal does not hold preempts the plan.
+        let (status, preempted) = engine.run_until(opts.max_ticks, |e| {
+            e.kb.as_ref()
+                .is_some_and(|kb| !kb.unmet_extra_goals().is_empty())
+        });
         let run_ms = tr.elapsed().as_secs_f64() * 1e3;
         let sum = engine.summary(status);
-        let done = sum.success();
+        let done = !preempted && sum.success();
         let end_tick = engine.tick;
-        let waited = if done || status == Status::Running {
+        let waited = if done || (status == Status::Running && !preempted) {
             0
         } else {
             engine.wait_for_faults(opts.max_ticks)
         };
+        let preempting: Vec<String> = if preempted {
+            engine
+                .kb
+                .as_ref()
+                .map(Kb::unmet_extra_goals)
+                .unwrap_or_default()
+        } else {
+            Vec::new()
+        };
+        let order_faults: Vec<String> = sum
+            .faults
+            .iter()
+            .filter(|f| {
+                f.kind == crate::faults::FaultKind::HighPriorityOrder && f.met_at == Some(end_tick)
+            })
+            .map(|f| f.fault.clone())
+            .collect();
         out.faults = engine.fault_outcomes(done);
         if trace {
             out.trace.push_str(&engine.trace_jsonl());
@@ -365,7 +403,7 @@ pub fn run_loop(
         carry.tick = engine.tick;
         carry.faults = Some(engine.take_faults());
         out.ticks = carry.tick;
-        out.goal_reached = goal_ok && done;
+        out.goal_reached = goal_ok && done && !for_priority;
         out.goal_failure = goal_why;
         out.attempts.push(Attempt {
             attempt,
@@ -387,11 +425,18 @@ pub fn run_loop(
             steps_total: sum.steps_total,
             records: sum.records.clone(),
             waited_ticks: waited,
+            preempted,
         });
+        if done && for_priority {
+            // The priority order is done: back to the whole goal.
+            carry.priority.clear();
+            out.goal_reached = false;
+            continue;
+        }
         if done {
             break;
         }
-        if status == Status::Running {
+        if status == Status::Running && !preempted {
             out.stopped = Some(format!(
                 "the loop ran out of ticks ({} in all)",
                 opts.max_ticks
@@ -445,19 +490,38 @@ pub fn run_loop(
                 }
             }
         }
-        let last = sum.records.last();
-        let why = last.map_or_else(
-            || "the tree failed".to_owned(),
-            |r| format!("`{}` ({}) failed: {}", r.node_name, r.node_id, r.reason),
-        );
-        let rp = Replan {
-            after_attempt: attempt,
-            tick: carry.tick,
-            why,
-            from_step: last.and_then(|r| r.step),
-            action: last.and_then(|r| r.action.clone()),
-            faults: last.map(|r| r.faults.clone()).unwrap_or_default(),
-            adjustments,
+        let rp = if preempted {
+            for g in &preempting {
+                adjustments.push(format!("`{g}` comes first: the order preempted the plan"));
+            }
+            carry.priority = preempting.clone();
+            Replan {
+                after_attempt: attempt,
+                tick: carry.tick,
+                why: format!(
+                    "a high-priority order preempted the plan at tick {end_tick}: {}",
+                    quoted(&preempting)
+                ),
+                from_step: None,
+                action: None,
+                faults: order_faults,
+                adjustments,
+            }
+        } else {
+            let last = sum.records.last();
+            let why = last.map_or_else(
+                || "the tree failed".to_owned(),
+                |r| format!("`{}` ({}) failed: {}", r.node_name, r.node_id, r.reason),
+            );
+            Replan {
+                after_attempt: attempt,
+                tick: carry.tick,
+                why,
+                from_step: last.and_then(|r| r.step),
+                action: last.and_then(|r| r.action.clone()),
+                faults: last.map(|r| r.faults.clone()).unwrap_or_default(),
+                adjustments,
+            }
         };
         if trace {
             let mut v = serde_json::to_value(&rp).unwrap_or_default();
@@ -538,6 +602,22 @@ fn goal_text(base: &str, carry: &Carry) -> String {
         g
     } else {
         format!("(and {g} {})", carry.extra_goals.join(" "))
+    }
+}
+
+/// The goals of the priority orders still to do, with spares for
+/// discarded parts.
+fn priority_text(carry: &Carry) -> String {
+    let mut parts: Vec<String> = carry.priority.clone();
+    for (p, s) in &carry.substitutions {
+        for g in &mut parts {
+            *g = replace_word(g, p, s);
+        }
+    }
+    if parts.len() == 1 {
+        parts.remove(0)
+    } else {
+        format!("(and {})", parts.join(" "))
     }
 }
 
