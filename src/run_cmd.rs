@@ -381,15 +381,14 @@ fn run_replan(a: &RunArgs, rules: &Path) -> anyhow::Result<ExitCode> {
     })
 }
 
+/// The loop's text summary (timings are in `--format json` only, so the
+/// text is the same from run to run).
 fn print_loop(s: &btc_runtime::LoopSummary) {
     for at in &s.attempts {
         let how = if at.source == "given" {
             "the given plan".to_owned()
         } else {
-            format!(
-                "planned in {:.3} ms, {} expanded",
-                at.planning_ms, at.expanded
-            )
+            format!("planned, {} expanded", at.expanded)
         };
         println!(
             "plan {} ({}, {how}) for {}:",
@@ -470,7 +469,7 @@ fn print_loop(s: &btc_runtime::LoopSummary) {
         println!("unreachable: {}{by}", u.literal);
     }
     println!(
-        "goal {}: {} after {}, {}, {} ({:.3} ms in all)",
+        "goal {}: {} after {}, {}, {}",
         s.goal,
         if s.goal_reached {
             "reached"
@@ -480,7 +479,6 @@ fn print_loop(s: &btc_runtime::LoopSummary) {
         report::plural(s.ticks as usize, "tick"),
         report::plural(s.attempts.len(), "plan"),
         report::plural(s.replans.len(), "replan"),
-        s.elapsed_ms
     );
     if let Some(why) = &s.goal_failure {
         println!("  goal: {why}");
