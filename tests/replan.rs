@@ -347,3 +347,21 @@ fn replanning_without_a_problem_is_refused_with_r017() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("R017"), "{err}");
 }
+
+#[test]
+fn a_malfunction_that_outlasts_the_tick_limit_is_named_in_the_report() {
+    let (code, s) = replan(
+        "problem.pddl",
+        Some("robot_malfunction"),
+        &["--max-ticks", "4"],
+    );
+    assert_eq!(code, 1);
+    assert_eq!(s["goal_reached"], false);
+    assert_eq!(s["attempts"][0]["waited_ticks"], 2);
+    let d = &s["diagnostics"][0];
+    assert_eq!(d["code"], "X008");
+    assert!(
+        d["message"].as_str().unwrap().contains("robot_malfunction"),
+        "{d}"
+    );
+}

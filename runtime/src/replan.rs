@@ -256,8 +256,16 @@ pub fn run_loop(
                     let un = unreachable(&w, &mut kb, &goal_text, g, &carry, opts)?;
                     let lits: Vec<String> = un.iter().map(|u| format!("`{}`", u.literal)).collect();
                     let by: Vec<String> = un.iter().flat_map(|u| u.faults.clone()).collect();
+                    // Faults still in effect (a malfunction that outlasted
+                    // the tick limit) count too.
+                    let in_effect = carry
+                        .faults
+                        .iter()
+                        .flatten()
+                        .filter(|rt| rt.met_at.is_some() && !rt.ended)
+                        .map(|rt| rt.spec.label());
                     let mut by_u: Vec<String> = Vec::new();
-                    for f in by {
+                    for f in by.into_iter().chain(in_effect) {
                         if !by_u.contains(&f) {
                             by_u.push(f);
                         }
