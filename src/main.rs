@@ -109,9 +109,17 @@ enum Command {
         /// A tree file to run instead: BT.CPP v4 XML or btc's JSON IR.
         #[arg(long)]
         tree: Option<PathBuf>,
-        /// The plan to compile (with RULES).
+        /// The plan to compile (with RULES); with `--replan`, the first plan
+        /// (default: planned from the problem).
         #[arg(long)]
         plan: Option<PathBuf>,
+        /// Close the loop: when the tree fails, plan again from the KB the
+        /// fault left (and the goal it adjusted), compile and run again.
+        #[arg(long, conflicts_with = "tree")]
+        replan: bool,
+        /// With `--replan`: plans made after failures, at most.
+        #[arg(long, default_value_t = 5, requires = "replan")]
+        max_replans: usize,
         /// The PDDL problem whose `:init` is the initial KB.
         #[arg(long)]
         problem: Option<PathBuf>,
@@ -290,6 +298,8 @@ fn main() -> ExitCode {
             rules,
             tree,
             plan,
+            replan,
+            max_replans,
             problem,
             domain,
             faults,
@@ -303,6 +313,8 @@ fn main() -> ExitCode {
             rules,
             tree,
             plan,
+            replan,
+            max_replans,
             problem,
             domain,
             faults,

@@ -113,14 +113,43 @@ pub fn load_job(
     domain_path: Option<&Path>,
     diags: &mut Vec<Diagnostic>,
 ) -> anyhow::Result<(Database, CompileJob)> {
+    load_job_with(
+        rules_path,
+        PlanInput::File(plan_path),
+        problem_path,
+        domain_path,
+        diags,
+    )
+}
+
+/// Where a job's plan comes from.
+pub enum PlanInput<'a> {
+    /// A plan file on disk.
+    File(&'a Path),
+    /// A plan that does not exist yet (the closed loop plans it): an empty
+    /// file under this name; the plan reader's diagnostics about it (L006,
+    /// no steps) are left out.
+    Planned(&'a str),
+}
+
+pub fn load_job_with(
+    rules_path: &Path,
+    plan_input: PlanInput,
+    problem_path: Option<&Path>,
+    domain_path: Option<&Path>,
+    diags: &mut Vec<Diagnostic>,
+) -> anyhow::Result<(Database, CompileJob)> {
     let mut database = Database::new();
     let rules = load_rules(&mut database, rules_path, diags)?;
-    let plan = files::load_into_db(&mut database, plan_path, diags)?;
+    let (plan, plan_path) = match plan_input {
+        PlanInput::File(p) => (files::load_into_db(&mut database, p, diags)?, Some(p)),
+        PlanInput::Planned(name) => (database.set_file(name, String::new()), None),
+    };
     let problem_path = problem_path.map(Path::to_path_buf).or_else(|| {
         if db::declared_path(&database, rules, true).is_some() {
             return None;
         }
-        [plan_path.parent(), rules_path.parent()]
+        [plan_path.and_then(Path::parent), rules_path.parent()]
             .into_iter()
             .flatten()
             .map(|d| d.join("problem.pddl"))
@@ -134,7 +163,13 @@ pub fn load_job(
         .map(|p| files::load_into_db(&mut database, p, diags))
         .transpose()?;
     let job = CompileJob::new(&database, rules, plan, problem, domain);
-    diags.extend(db::job_diagnostics(&database, job).iter().cloned());
+    let planned = plan_path.is_none().then(|| db::file_id(&database, plan));
+    diags.extend(
+        db::job_diagnostics(&database, job)
+            .iter()
+            .filter(|d| Some(d.span.file) != planned || !d.code.starts_with('L'))
+            .cloned(),
+    );
     Ok((database, job))
 }
 

@@ -16,6 +16,8 @@ pub struct RunArgs {
     pub rules: Option<PathBuf>,
     pub tree: Option<PathBuf>,
     pub plan: Option<PathBuf>,
+    pub replan: bool,
+    pub max_replans: usize,
     pub problem: Option<PathBuf>,
     pub domain: Option<PathBuf>,
     pub faults: Option<PathBuf>,
@@ -60,10 +62,11 @@ fn fail(diags: &[Diagnostic], sources: &Sources, format: Format) -> anyhow::Resu
 
 pub fn run(a: &RunArgs) -> anyhow::Result<ExitCode> {
     match (&a.rules, &a.tree) {
+        (Some(rules), None) if a.replan => run_replan(a, rules),
         (Some(rules), None) => {
             let plan = a.plan.as_deref().ok_or_else(|| {
                 anyhow::anyhow!(
-                    "`btc run RULES` needs `--plan PLAN` (or run a tree file with `--tree`)"
+                    "`btc run RULES` needs `--plan PLAN` (or `--replan` to plan from the problem, or run a tree file with `--tree`)"
                 )
             })?;
             run_rules(a, rules, plan)
@@ -273,5 +276,214 @@ fn print_summary(s: &Summary, commands: Option<usize>) {
             "record: tick {}: `{}` ({}){step} failed: {}{faults}",
             r.tick, r.node_name, r.node_id, r.reason
         );
+    }
+}
+
+/// The name of the plan the closed loop writes (it is never written to
+/// disk; diagnostics about a planned plan name it).
+const PLANNED: &str = "(planned).sas_plan";
+
+/// `btc run RULES --replan`: the closed loop of `btc_runtime::replan`.
+fn run_replan(a: &RunArgs, rules: &Path) -> anyhow::Result<ExitCode> {
+    if a.controller {
+        anyhow::bail!("`--replan` runs the simulated world only; leave out `--controller`");
+    }
+    let mut diags = Vec::new();
+    let input = match &a.plan {
+        Some(p) => rules_cmd::PlanInput::File(p),
+        None => rules_cmd::PlanInput::Planned(PLANNED),
+    };
+    let (mut database, job) = rules_cmd::load_job_with(
+        rules,
+        input,
+        a.problem.as_deref(),
+        a.domain.as_deref(),
+        &mut diags,
+    )?;
+    if has_errors(&diags) || btc_runtime::JobWorld::of(&database, job).is_none() {
+        return fail(&diags, &database.sources(), a.format);
+    }
+    // The scenario: read and parsed before the loop (its facts are checked
+    // against the problem when the first tree is built).
+    let mut scen_sources = Sources::new();
+    let scenario = match &a.faults {
+        Some(path) => {
+            let mut d = Vec::new();
+            let f = files::load(&mut scen_sources, path, &mut d)?;
+            if has_errors(&d) {
+                return fail(&d, &scen_sources, a.format);
+            }
+            match Scenario::parse(scen_sources.text(f)) {
+                Ok(s) => Some((s, f)),
+                Err(e) => {
+                    return fail(&[diagnostic(&e, f, &scen_sources)], &scen_sources, a.format)
+                }
+            }
+        }
+        None => None,
+    };
+    let opts = btc_runtime::LoopOptions {
+        engine: Options {
+            ticks_per_action: a.ticks_per_action,
+            ms_per_tick: if a.tick_ms > 0 { a.tick_ms } else { 10 },
+            trace: a.trace.is_some(),
+        },
+        planner: btc_planner::Options::default(),
+        max_replans: a.max_replans,
+        max_ticks: a.max_ticks,
+    };
+    let result = btc_runtime::run_loop(
+        &mut database,
+        job,
+        a.plan.is_some(),
+        scenario.as_ref().map(|(s, _)| s),
+        &opts,
+    );
+    let sources = database.sources();
+    let summary = match result {
+        Ok(s) => s,
+        Err(btc_runtime::LoopError::Compile(ds)) => {
+            diags.extend(ds);
+            return fail(&diags, &sources, a.format);
+        }
+        Err(btc_runtime::LoopError::Tree(e)) => {
+            let anchor = db::file_id(&database, job.plan(&database));
+            return fail(&[diagnostic(&e, anchor, &sources)], &sources, a.format);
+        }
+        Err(btc_runtime::LoopError::Scenario(e)) => {
+            let f = scenario.map_or(0, |(_, f)| f);
+            return fail(&[diagnostic(&e, f, &scen_sources)], &scen_sources, a.format);
+        }
+    };
+    if let Some(path) = &a.trace {
+        files::write_atomically(path, &summary.trace)?;
+    }
+    match a.format {
+        Format::Json => {
+            let mut v = serde_json::to_value(&summary)?;
+            let json = report::diagnostics(&summary.diagnostics, &sources, a.format);
+            if let Some(o) = v.as_object_mut() {
+                o.insert("ok".into(), summary.success().into());
+                o.insert("diagnostics".into(), json.into());
+            }
+            println!("{}", serde_json::to_string_pretty(&v)?);
+        }
+        Format::Text => {
+            report::diagnostics(&diags, &sources, a.format);
+            print_loop(&summary);
+            report::diagnostics(&summary.diagnostics, &sources, a.format);
+        }
+    }
+    Ok(if summary.success() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
+}
+
+/// The loop's text summary (timings are in `--format json` only, so the
+/// text is the same from run to run).
+fn print_loop(s: &btc_runtime::LoopSummary) {
+    for at in &s.attempts {
+        let how = if at.source == "given" {
+            "the given plan".to_owned()
+        } else {
+            format!("planned, {} expanded", at.expanded)
+        };
+        println!(
+            "plan {} ({}, {how}) for {}:",
+            at.attempt,
+            report::plural(at.plan.len(), "step"),
+            at.goal
+        );
+        for (i, step) in at.plan.iter().enumerate() {
+            println!("  {}. {step}", i + 1);
+        }
+        println!(
+            "  {} at tick {} (ticks {}-{}); {} of {} plan steps done",
+            if at.preempted {
+                "PREEMPTED"
+            } else {
+                at.status.name()
+            },
+            at.end_tick,
+            at.start_tick + 1,
+            at.end_tick,
+            at.steps_done,
+            at.steps_total
+        );
+        for r in &at.records {
+            let step = r
+                .action
+                .as_deref()
+                .map(|a| format!(" in {a}"))
+                .unwrap_or_default();
+            let faults = if r.faults.is_empty() {
+                String::new()
+            } else {
+                format!(" [fault: {}]", r.faults.join(", "))
+            };
+            println!(
+                "  record: tick {}: `{}` ({}){step} failed: {}{faults}",
+                r.tick, r.node_name, r.node_id, r.reason
+            );
+        }
+        if at.status == btc_runtime::Status::Success && !at.preempted && at.goal != s.goal {
+            println!("  the priority order is done; planning for the whole goal");
+        }
+        if at.waited_ticks > 0 {
+            println!(
+                "  waited {} for the faults in effect to end",
+                report::plural(at.waited_ticks as usize, "tick")
+            );
+        }
+        if let Some((k, rp)) = s
+            .replans
+            .iter()
+            .enumerate()
+            .find(|(_, r)| r.after_attempt == at.attempt)
+        {
+            let from = match (&rp.from_step, &rp.action) {
+                (Some(_), Some(a)) => format!(" from {a}"),
+                _ => String::new(),
+            };
+            println!("replan {} at tick {}{from}: {}", k + 1, rp.tick, rp.why);
+            for adj in &rp.adjustments {
+                println!("  goal: {adj}");
+            }
+        }
+    }
+    for f in &s.faults {
+        let met = match f.met_at {
+            Some(t) => format!("met at tick {t}"),
+            None => "not met".to_owned(),
+        };
+        println!("fault {} ({}): {met}; {}", f.fault, f.kind.name(), f.ended);
+    }
+    for u in &s.unreachable {
+        let by = if u.faults.is_empty() {
+            String::new()
+        } else {
+            format!(" (fault: {})", u.faults.join(", "))
+        };
+        println!("unreachable: {}{by}", u.literal);
+    }
+    println!(
+        "goal {}: {} after {}, {}, {}",
+        s.goal,
+        if s.goal_reached {
+            "reached"
+        } else {
+            "not reached"
+        },
+        report::plural(s.ticks as usize, "tick"),
+        report::plural(s.attempts.len(), "plan"),
+        report::plural(s.replans.len(), "replan"),
+    );
+    if let Some(why) = &s.goal_failure {
+        println!("  goal: {why}");
+    }
+    if let Some(why) = &s.stopped {
+        println!("stopped: {why}");
     }
 }

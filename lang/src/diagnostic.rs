@@ -250,5 +250,7 @@ pub mod codes {
         X_KB = "X005", "a KB formula or effect in a tree that does not fit the problem";
         X_SCENARIO = "X006", "a fault scenario file that is not valid";
         X_TOO_DEEP = "X007", "a tree nested deeper than the runtime runs";
+        X_REPLAN_UNSOLVABLE = "X008", "a goal that replanning cannot reach after a fault";
+        X_REPLAN_LIMIT = "X009", "a closed loop that stopped at its replan or tick limit";
     }
 }

@@ -544,6 +544,35 @@ impl<'w> Engine<'w> {
         }
     }
 
+    /// Ticks like [`Engine::run`], but halts the tree and returns
+    /// `(Status::Running, true)` as soon as `stop` says so after a tick
+    /// (replanning preempts a plan this way).
+    pub fn run_until(
+        &mut self,
+        max_ticks: u64,
+        mut stop: impl FnMut(&Engine<'w>) -> bool,
+    ) -> (Status, bool) {
+        loop {
+            let s = self.tick_once();
+            if s != Status::Running {
+                self.finish(s);
+                return (s, false);
+            }
+            if stop(self) {
+                self.halt_all();
+                return (Status::Running, true);
+            }
+            if self.tick >= max_ticks {
+                self.halt_all();
+                self.finish(Status::Running);
+                return (Status::Running, false);
+            }
+            if let Some(c) = self.controller.as_mut() {
+                c.wait_any(std::time::Duration::from_secs(1));
+            }
+        }
+    }
+
     /// Halts the whole tree (every running node, leaves first).
     pub fn halt_all(&mut self) {
         if !self.nodes.is_empty() {

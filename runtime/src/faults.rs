@@ -427,6 +427,65 @@ impl<'w> Engine<'w> {
         self.refresh_live();
     }
 
+    /// Takes the faults' run-time state out of the engine (which keeps no
+    /// faults): replanning moves it to the next plan's engine, so a fault
+    /// that fired does not fire again. Call after [`Engine::trace_jsonl`]:
+    /// the trace names faults by their place in this list.
+    pub(crate) fn take_faults(&mut self) -> Vec<FaultRt> {
+        let v = std::mem::take(&mut self.faults);
+        self.refresh_live();
+        v
+    }
+
+    /// Puts faults taken from an earlier engine into this one; the goals
+    /// of faults still to come are re-read in this engine's KB.
+    pub(crate) fn restore_faults(&mut self, mut faults: Vec<FaultRt>) {
+        for rt in &mut faults {
+            rt.goal = match (&rt.spec.goal, self.kb.as_mut()) {
+                (Some(g), Some(kb)) => kb.formula(g).ok(),
+                _ => None,
+            };
+        }
+        self.faults = faults;
+        self.refresh_live();
+    }
+
+    /// Whether a fault with a duration (a malfunction, a pause, a
+    /// blackout) is in effect.
+    pub fn timed_fault_in_effect(&self) -> bool {
+        (0..self.faults.len()).any(|f| self.in_effect(f) && self.faults[f].until.is_some())
+    }
+
+    /// Lets time pass, with no tree ticked, until no fault with a duration
+    /// is in effect or tick `limit` is reached; faults due meanwhile start
+    /// and end (a malfunction's repair gives its facts back). Returns the
+    /// ticks waited.
+    pub fn wait_for_faults(&mut self, limit: u64) -> u64 {
+        let start = self.tick;
+        while self.timed_fault_in_effect() && self.tick < limit {
+            self.tick += 1;
+            self.now_ms = self.tick.saturating_mul(self.opts.ms_per_tick);
+            self.faults_before_tick();
+        }
+        self.tick - start
+    }
+
+    /// The parts that faults discarded or found missing (`faulty_part`,
+    /// `insufficient_parts`), with the fault's label.
+    pub fn discarded_parts(&self) -> Vec<(String, String)> {
+        self.faults
+            .iter()
+            .filter(|rt| {
+                rt.met_at.is_some()
+                    && matches!(
+                        rt.spec.kind,
+                        FaultKind::FaultyPart | FaultKind::InsufficientParts
+                    )
+            })
+            .filter_map(|rt| rt.spec.part.clone().map(|p| (p, rt.spec.label())))
+            .collect()
+    }
+
     pub(crate) fn faults_before_tick(&mut self) {
         let tick = self.tick;
         for f in 0..self.faults.len() {
@@ -593,4 +652,25 @@ impl<'w> Engine<'w> {
             })
             .collect()
     }
+}
+
+/// The met faults that removed or added a fact `text` shows, or whose part
+/// or robot it names (`text`: a goal literal): their labels.
+pub(crate) fn naming(faults: &[FaultRt], text: &str) -> Vec<String> {
+    let words: Vec<&str> = text
+        .split(|c: char| c.is_whitespace() || c == '(' || c == ')')
+        .filter(|w| !w.is_empty())
+        .collect();
+    faults
+        .iter()
+        .filter(|rt| rt.met_at.is_some())
+        .filter(|rt| {
+            [&rt.spec.part, &rt.spec.robot]
+                .into_iter()
+                .flatten()
+                .any(|o| words.contains(&o.as_str()))
+                || rt.shown.iter().any(|s| text.contains(s.as_str()))
+        })
+        .map(|rt| rt.spec.label())
+        .collect()
 }

@@ -24,6 +24,8 @@ pub struct Kb<'w> {
     effect_ids: FxHashMap<String, EffectId>,
     /// Goals added while running (a high-priority order).
     extra_goals: Vec<FormulaId>,
+    /// A goal that replaces the problem's (replanning adjusts the goal).
+    goal_override: Option<FormulaId>,
 }
 
 impl<'w> Kb<'w> {
@@ -46,7 +48,48 @@ impl<'w> Kb<'w> {
             formula_ids: FxHashMap::default(),
             effect_ids: FxHashMap::default(),
             extra_goals: Vec::new(),
+            goal_override: None,
         }
+    }
+
+    /// The problem the KB was made from.
+    pub fn problem(&self) -> &'w Problem {
+        self.problem
+    }
+
+    /// A parsed formula (from [`Kb::formula`]).
+    pub fn formula_ast(&self, f: FormulaId) -> &Formula {
+        &self.formulas[f as usize]
+    }
+
+    /// The text of a formula registered with [`Kb::formula`].
+    pub fn formula_text(&self, f: FormulaId) -> Option<&str> {
+        self.formula_ids
+            .iter()
+            .find(|(_, &id)| id == f)
+            .map(|(t, _)| t.as_str())
+    }
+
+    /// The goals added while running, as their texts, in the order added.
+    pub fn extra_goal_texts(&self) -> Vec<String> {
+        self.extra_goals
+            .iter()
+            .filter_map(|&f| self.formula_text(f).map(str::to_owned))
+            .collect()
+    }
+
+    /// The goals added while running that do not hold, as their texts.
+    pub fn unmet_extra_goals(&self) -> Vec<String> {
+        self.extra_goals
+            .iter()
+            .filter(|&&f| !self.holds(f))
+            .filter_map(|&f| self.formula_text(f).map(str::to_owned))
+            .collect()
+    }
+
+    /// Makes `f` the goal instead of the problem's (added goals still count).
+    pub fn set_goal(&mut self, f: FormulaId) {
+        self.goal_override = Some(f);
     }
 
     fn sexp(text: &str) -> Result<sexpr::Sexp, String> {
@@ -268,7 +311,11 @@ impl<'w> Kb<'w> {
     /// Whether the problem's goal (and every added goal) holds; with the
     /// first part that does not.
     pub fn goal(&self) -> (bool, Option<String>) {
-        if let Some(g) = &self.problem.goal {
+        if let Some(g) = self.goal_override {
+            if !self.holds(g) {
+                return (false, Some(self.why_not(g)));
+            }
+        } else if let Some(g) = &self.problem.goal {
             if !self.world.holds(&self.state, g, &mut Env::new(), None) {
                 let (why, _) = self.world.why_not(&self.state, g, &mut Env::new(), None);
                 return (false, Some(why));

@@ -13,6 +13,7 @@ pub mod engine;
 pub mod error;
 pub mod faults;
 pub mod kb;
+pub mod replan;
 pub mod spec;
 pub mod xml;
 
@@ -21,6 +22,7 @@ pub use engine::{Engine, FaultRecord, Options, Status, Value};
 pub use error::LoadError;
 pub use faults::{FaultKind, FaultOutcome, Scenario};
 pub use kb::Kb;
+pub use replan::{run_loop, LoopError, LoopOptions, LoopSummary};
 pub use spec::TreeDoc;
 
 use serde::Serialize;
