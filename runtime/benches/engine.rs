@@ -105,6 +105,15 @@ fn sequence_of_1000_always_success(b: Bencher) {
         .bench_local(|| complete(&mut e));
 }
 
+/// The same with simulated action leaves that finish at once.
+#[divan::bench(sample_count = 100, sample_size = 100)]
+fn sequence_of_1000_instant_actions(b: Bencher) {
+    let acts = (0..1000).map(|_| leaf("Work", LeafKind::Action)).collect();
+    let mut e = Engine::build(&doc(node(Kind::Sequence, acts)), None, opts(0)).unwrap();
+    b.counter(ItemsCount::new(1000usize))
+        .bench_local(|| complete(&mut e));
+}
+
 /// Leaf ticks per completion: 101 with actions that finish at once; with
 /// one-tick actions 101 ticks of (condition + finishing action + starting
 /// action) minus the ends: 101 + 200.
