@@ -105,12 +105,12 @@ fn sequence_of_1000_always_success(b: Bencher) {
         .bench_local(|| complete(&mut e));
 }
 
-/// The same with simulated action leaves that finish at once.
-#[divan::bench(sample_count = 100, sample_size = 100)]
-fn sequence_of_1000_instant_actions(b: Bencher) {
-    let acts = (0..1000).map(|_| leaf("Work", LeafKind::Action)).collect();
+/// A Sequence of simulated action leaves that finish at once.
+#[divan::bench(args = [100, 1000], sample_count = 100, sample_size = 100)]
+fn sequence_of_instant_actions(b: Bencher, n: usize) {
+    let acts = (0..n).map(|_| leaf("Work", LeafKind::Action)).collect();
     let mut e = Engine::build(&doc(node(Kind::Sequence, acts)), None, opts(0)).unwrap();
-    b.counter(ItemsCount::new(1000usize))
+    b.counter(ItemsCount::new(n))
         .bench_local(|| complete(&mut e));
 }
 
