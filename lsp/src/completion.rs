@@ -157,19 +157,7 @@ fn item(
 }
 
 fn signature(name: &str, ports: &[PortDecl]) -> String {
-    format!(
-        "{name}({})",
-        ports
-            .iter()
-            .map(|p| format!(
-                "{}{}: {}",
-                if p.out { "out " } else { "" },
-                p.name.text,
-                p.ty.text
-            ))
-            .collect::<Vec<_>>()
-            .join(", ")
-    )
+    format!("{name}({})", btc_lang::rules::fmt::ports(ports))
 }
 
 /// Variables in scope at `offset`: a rule's parameters, a tree's ports.

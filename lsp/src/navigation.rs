@@ -88,19 +88,11 @@ pub fn hover(a: &Analysis, offset: usize) -> Option<Hover> {
                         NodeKind::Action => "action",
                         NodeKind::Condition => "condition",
                     };
-                    let ports: Vec<String> = n
-                        .ports
-                        .iter()
-                        .map(|p| {
-                            format!(
-                                "{}{}: {}",
-                                if p.out { "out " } else { "" },
-                                p.name.text,
-                                p.ty.text
-                            )
-                        })
-                        .collect();
-                    let mut s = format!("{kind} {}({})", n.name.text, ports.join(", "));
+                    let mut s = format!(
+                        "{kind} {}({})",
+                        n.name.text,
+                        btc_lang::rules::fmt::ports(&n.ports)
+                    );
                     if let Some(f) = &n.formula {
                         let src = a.source_of(
                             place.file,
@@ -111,12 +103,11 @@ pub fn hover(a: &Analysis, offset: usize) -> Option<Hover> {
                     s
                 }
                 Item::Tree(t) => {
-                    let ports: Vec<String> = t
-                        .ports
-                        .iter()
-                        .map(|p| format!("{}: {}", p.name.text, p.ty.text))
-                        .collect();
-                    format!("tree {}({})", t.name.text, ports.join(", "))
+                    format!(
+                        "tree {}({})",
+                        t.name.text,
+                        btc_lang::rules::fmt::ports(&t.ports)
+                    )
                 }
                 _ => return None,
             };

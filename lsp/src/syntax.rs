@@ -12,17 +12,7 @@ use btc_lang::source::Span;
 /// Item keywords: a name after one of these is being declared.
 pub const DECL_KEYWORDS: &[&str] = &["action", "condition", "tree", "table"];
 
-pub const ITEM_KEYWORDS: &[&str] = &[
-    "domain",
-    "problem",
-    "import",
-    "action",
-    "condition",
-    "tree",
-    "table",
-    "rule",
-    "plan",
-];
+pub use btc_lang::rules::parse::ITEM_KEYWORDS;
 
 pub const TEMPLATE_KEYWORDS: &[&str] = &[
     "sequence",

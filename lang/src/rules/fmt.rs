@@ -305,18 +305,19 @@ fn template_line(t: &Template) -> String {
     }
 }
 
-fn ports(ps: &[PortDecl]) -> String {
-    ps.iter()
-        .map(|p| {
-            format!(
-                "{}{}: {}",
-                if p.out { "out " } else { "" },
-                p.name.text,
-                p.ty.text
-            )
-        })
-        .collect::<Vec<_>>()
-        .join(", ")
+/// A port declaration as written: `out name: type`.
+pub fn port(p: &PortDecl) -> String {
+    format!(
+        "{}{}: {}",
+        if p.out { "out " } else { "" },
+        p.name.text,
+        p.ty.text
+    )
+}
+
+/// A declaration's port list, without the parentheses.
+pub fn ports(ps: &[PortDecl]) -> String {
+    ps.iter().map(port).collect::<Vec<_>>().join(", ")
 }
 
 fn pattern(p: &Pattern) -> String {

@@ -16,7 +16,8 @@ use chumsky::prelude::*;
 /// Deepest nesting of brackets inside one item.
 pub const MAX_ITEM_DEPTH: usize = 64;
 
-const ITEM_KEYWORDS: &[&str] = &[
+/// Words that start a top-level item.
+pub const ITEM_KEYWORDS: &[&str] = &[
     "domain",
     "problem",
     "import",
