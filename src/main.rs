@@ -102,53 +102,7 @@ enum Command {
     Lsp,
     /// Run a compiled plan (or a tree file) against the problem's simulated
     /// world; exit 0 only when the tree succeeds and the goal holds.
-    Run {
-        /// The rules file to compile the plan with.
-        #[arg(required_unless_present = "tree", conflicts_with = "tree")]
-        rules: Option<PathBuf>,
-        /// A tree file to run instead: BT.CPP v4 XML or btc's JSON IR.
-        #[arg(long)]
-        tree: Option<PathBuf>,
-        /// The plan to compile (with RULES); with `--replan`, the first plan
-        /// (default: planned from the problem).
-        #[arg(long)]
-        plan: Option<PathBuf>,
-        /// Close the loop: when the tree fails, plan again from the KB the
-        /// fault left (and the goal it adjusted), compile and run again.
-        #[arg(long, conflicts_with = "tree")]
-        replan: bool,
-        /// With `--replan`: plans made after failures, at most.
-        #[arg(long, default_value_t = 5, requires = "replan")]
-        max_replans: usize,
-        /// The PDDL problem whose `:init` is the initial KB.
-        #[arg(long)]
-        problem: Option<PathBuf>,
-        /// The PDDL domain (default: the rules file's, or `domain.pddl`
-        /// beside the problem).
-        #[arg(long)]
-        domain: Option<PathBuf>,
-        /// A fault scenario (TOML) to inject.
-        #[arg(long)]
-        faults: Option<PathBuf>,
-        /// Write every status change here, as JSON Lines (atomically).
-        #[arg(long)]
-        trace: Option<PathBuf>,
-        /// Ticks an action leaf stays RUNNING before it succeeds.
-        #[arg(long, default_value_t = 1)]
-        ticks_per_action: u32,
-        /// Wall-clock milliseconds between ticks (also the simulated time
-        /// per tick; 0: as fast as possible, 10 ms simulated).
-        #[arg(long, default_value_t = 0)]
-        tick_ms: u64,
-        /// Give up (and halt the tree) after this many ticks.
-        #[arg(long, default_value_t = 100_000)]
-        max_ticks: u64,
-        /// Send action leaves' commands through the queued controller thread.
-        #[arg(long)]
-        controller: bool,
-        #[arg(long, value_enum, default_value_t)]
-        format: Format,
-    },
+    Run(run_cmd::RunArgs),
     /// Check that a plan is valid: every step applicable, the goal reached.
     Validate {
         domain: PathBuf,
@@ -294,37 +248,7 @@ fn main() -> ExitCode {
         Command::Lsp => btc_lsp::run_stdio()
             .map(|()| ExitCode::SUCCESS)
             .map_err(anyhow::Error::from),
-        Command::Run {
-            rules,
-            tree,
-            plan,
-            replan,
-            max_replans,
-            problem,
-            domain,
-            faults,
-            trace,
-            ticks_per_action,
-            tick_ms,
-            max_ticks,
-            controller,
-            format,
-        } => run_cmd::run(&run_cmd::RunArgs {
-            rules,
-            tree,
-            plan,
-            replan,
-            max_replans,
-            problem,
-            domain,
-            faults,
-            trace,
-            ticks_per_action,
-            tick_ms,
-            max_ticks,
-            controller,
-            format,
-        }),
+        Command::Run(args) => run_cmd::run(&args),
         Command::Validate {
             domain,
             problem,

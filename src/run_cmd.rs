@@ -12,20 +12,53 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Duration;
 
+/// `btc run`'s arguments.
+#[derive(clap::Args)]
 pub struct RunArgs {
+    /// The rules file to compile the plan with.
+    #[arg(required_unless_present = "tree", conflicts_with = "tree")]
     pub rules: Option<PathBuf>,
+    /// A tree file to run instead: BT.CPP v4 XML or btc's JSON IR.
+    #[arg(long)]
     pub tree: Option<PathBuf>,
+    /// The plan to compile (with RULES); with `--replan`, the first plan
+    /// (default: planned from the problem).
+    #[arg(long)]
     pub plan: Option<PathBuf>,
+    /// Close the loop: when the tree fails, plan again from the KB the
+    /// fault left (and the goal it adjusted), compile and run again.
+    #[arg(long, conflicts_with = "tree")]
     pub replan: bool,
+    /// With `--replan`: plans made after failures, at most.
+    #[arg(long, default_value_t = 5, requires = "replan")]
     pub max_replans: usize,
+    /// The PDDL problem whose `:init` is the initial KB.
+    #[arg(long)]
     pub problem: Option<PathBuf>,
+    /// The PDDL domain (default: the rules file's, or `domain.pddl`
+    /// beside the problem).
+    #[arg(long)]
     pub domain: Option<PathBuf>,
+    /// A fault scenario (TOML) to inject.
+    #[arg(long)]
     pub faults: Option<PathBuf>,
+    /// Write every status change here, as JSON Lines (atomically).
+    #[arg(long)]
     pub trace: Option<PathBuf>,
+    /// Ticks an action leaf stays RUNNING before it succeeds.
+    #[arg(long, default_value_t = 1)]
     pub ticks_per_action: u32,
+    /// Wall-clock milliseconds between ticks (also the simulated time
+    /// per tick; 0: as fast as possible, 10 ms simulated).
+    #[arg(long, default_value_t = 0)]
     pub tick_ms: u64,
+    /// Give up (and halt the tree) after this many ticks.
+    #[arg(long, default_value_t = 100_000)]
     pub max_ticks: u64,
+    /// Send action leaves' commands through the queued controller thread.
+    #[arg(long)]
     pub controller: bool,
+    #[arg(long, value_enum, default_value_t)]
     pub format: Format,
 }
 
