@@ -5,9 +5,8 @@
 
 use crate::convert::LineIndex;
 use btc_lang::db::{
-    checked_domain, checked_problem, declared_path, domain_file, file_id, import_closure,
-    normalize, parsed_rules, problem_file, rules_diagnostics, Database, Db as _, ProblemOf,
-    SourceFile,
+    checked_domain, checked_problem, domain_file, file_id, normalize, parsed_rules, problem_file,
+    rules_diagnostics, Database, Db as _, ProblemOf, SourceFile,
 };
 use btc_lang::diagnostic::Diagnostic;
 use btc_lang::rules::{ImportTarget, Item};
@@ -190,18 +189,6 @@ impl Workspace {
             .map(|(p, _)| p.clone())
     }
 
-    /// The rules files whose import closure holds `file`.
-    pub fn rules_using(&self, file: SourceFile) -> Vec<SourceFile> {
-        self.open_rules()
-            .into_iter()
-            .filter(|r| {
-                import_closure(&self.db, *r).0.contains(&file)
-                    || domain_file(&self.db, *r) == Some(file)
-                    || problem_file(&self.db, *r) == Some(file)
-            })
-            .collect()
-    }
-
     /// Diagnostics of every open rules document and of the PDDL files they
     /// name (and of open PDDL domains), grouped by file; files that had
     /// diagnostics last time and have none now get an empty list.
@@ -283,18 +270,6 @@ impl Workspace {
         out
     }
 
-    /// The domain a rules file names, parsed (when it reads).
-    pub fn domain_of(
-        &self,
-        rules: SourceFile,
-    ) -> Option<(SourceFile, &btc_lang::pddl::ast::Domain)> {
-        let d = domain_file(&self.db, rules)?;
-        checked_domain(&self.db, d)
-            .domain
-            .as_ref()
-            .map(|dom| (d, dom))
-    }
-
     /// Where a rules file's `domain` / `problem` / import string points.
     pub fn resolve_written(&self, from: SourceFile, written: &str) -> Option<String> {
         let dir = Path::new(from.path(&self.db))
@@ -303,11 +278,6 @@ impl Workspace {
             .unwrap_or_default();
         let full = normalize(&dir.join(written));
         self.db.file(&full).map(|_| full)
-    }
-
-    /// Whether the rules file names its domain (for messages).
-    pub fn names_domain(&self, rules: SourceFile) -> bool {
-        declared_path(&self.db, rules, false).is_some()
     }
 }
 
