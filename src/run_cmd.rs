@@ -295,20 +295,7 @@ fn print_summary(s: &Summary, commands: Option<usize>) {
         println!("fault {} ({}): {met}; {}", f.fault, f.kind.name(), f.ended);
     }
     for r in &s.records {
-        let step = r
-            .action
-            .as_deref()
-            .map(|a| format!(" in {a}"))
-            .unwrap_or_default();
-        let faults = if r.faults.is_empty() {
-            String::new()
-        } else {
-            format!(" [fault: {}]", r.faults.join(", "))
-        };
-        println!(
-            "record: tick {}: `{}` ({}){step} failed: {}{faults}",
-            r.tick, r.node_name, r.node_id, r.reason
-        );
+        println!("{}", record_line(r));
     }
 }
 
@@ -446,20 +433,7 @@ fn print_loop(s: &btc_runtime::LoopSummary) {
             at.steps_total
         );
         for r in &at.records {
-            let step = r
-                .action
-                .as_deref()
-                .map(|a| format!(" in {a}"))
-                .unwrap_or_default();
-            let faults = if r.faults.is_empty() {
-                String::new()
-            } else {
-                format!(" [fault: {}]", r.faults.join(", "))
-            };
-            println!(
-                "  record: tick {}: `{}` ({}){step} failed: {}{faults}",
-                r.tick, r.node_name, r.node_id, r.reason
-            );
+            println!("  {}", record_line(r));
         }
         if at.status == btc_runtime::Status::Success && !at.preempted && at.goal != s.goal {
             println!("  the priority order is done; planning for the whole goal");
@@ -519,4 +493,22 @@ fn print_loop(s: &btc_runtime::LoopSummary) {
     if let Some(why) = &s.stopped {
         println!("stopped: {why}");
     }
+}
+
+/// One fault record as the summaries print it.
+fn record_line(r: &btc_runtime::FaultRecord) -> String {
+    let step = r
+        .action
+        .as_deref()
+        .map(|a| format!(" in {a}"))
+        .unwrap_or_default();
+    let faults = if r.faults.is_empty() {
+        String::new()
+    } else {
+        format!(" [fault: {}]", r.faults.join(", "))
+    };
+    format!(
+        "record: tick {}: `{}` ({}){step} failed: {}{faults}",
+        r.tick, r.node_name, r.node_id, r.reason
+    )
 }
