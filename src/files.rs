@@ -1,8 +1,8 @@
 //! Reading input files into [`Sources`], with encoding problems reported as
 //! diagnostics rather than failures.
 
-use btc_lang::diagnostic::{codes, Diagnostic};
-use btc_lang::source::{decode, DecodeProblem, FileId, Sources, Span};
+use btc_pddl::diagnostic::{codes, Diagnostic};
+use btc_pddl::source::{decode, DecodeProblem, FileId, Sources, Span};
 use std::path::Path;
 
 /// A file's text as read from disk, and what was wrong with it.
@@ -15,7 +15,7 @@ struct Read {
 /// Reads and decodes a file. `Err` only when it cannot be read at all.
 fn read(path: &Path) -> anyhow::Result<Read> {
     let len = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
-    if len > btc_lang::source::MAX_FILE_BYTES as u64 {
+    if len > btc_pddl::source::MAX_FILE_BYTES as u64 {
         return Ok(Read {
             text: String::new(),
             problem: Some(DecodeProblem::TooLarge {
@@ -104,7 +104,7 @@ fn too_large(id: FileId, bytes: u64) -> Diagnostic {
         Span::new(id, 0, 0),
         format!(
             "this file has {bytes} bytes; btc reads files of at most {} bytes",
-            btc_lang::source::MAX_FILE_BYTES
+            btc_pddl::source::MAX_FILE_BYTES
         ),
     )
 }

@@ -168,9 +168,9 @@ enum EmitFormat {
     Commands,
 }
 
-impl From<EmitFormat> for btc_lang::emit::Format {
+impl From<EmitFormat> for btc_emit::Format {
     fn from(f: EmitFormat) -> Self {
-        use btc_lang::emit::Format as F;
+        use btc_emit::Format as F;
         match f {
             EmitFormat::Btcpp => F::Btcpp,
             EmitFormat::Pytrees => F::Pytrees,
@@ -238,7 +238,7 @@ fn main() -> ExitCode {
             domain,
             emit: emit.into(),
             output,
-            options: btc_lang::emit::Options {
+            options: btc_emit::Options {
                 inline,
                 node_module,
             },

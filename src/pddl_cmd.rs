@@ -1,10 +1,10 @@
 //! `btc pddl FILE...`: parse and check domains and problems.
 
 use crate::{files, report, Format};
-use btc_lang::diagnostic::{codes, Diagnostic};
-use btc_lang::pddl::{self, Document};
-use btc_lang::pipeline::{domain_unit, problem_unit, DomainUnit};
-use btc_lang::source::Sources;
+use btc_pddl::diagnostic::{codes, Diagnostic};
+use btc_pddl::pipeline::{domain_unit, problem_unit, DomainUnit};
+use btc_pddl::source::Sources;
+use btc_pddl::{self as pddl, Document};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 

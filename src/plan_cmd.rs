@@ -2,9 +2,9 @@
 //! (or atomically to `-o`), statistics to stderr.
 
 use crate::{files, report, Format};
-use btc_lang::diagnostic::has_errors;
-use btc_lang::pipeline::{domain_unit, problem_unit};
-use btc_lang::source::Sources;
+use btc_pddl::diagnostic::has_errors;
+use btc_pddl::pipeline::{domain_unit, problem_unit};
+use btc_pddl::source::Sources;
 use btc_planner::{Heuristic, Options, Outcome};
 use std::path::Path;
 use std::process::ExitCode;
@@ -103,7 +103,7 @@ pub fn run(args: &PlanArgs) -> anyhow::Result<ExitCode> {
 }
 
 fn finish(
-    diags: &[btc_lang::diagnostic::Diagnostic],
+    diags: &[btc_pddl::diagnostic::Diagnostic],
     sources: &Sources,
     format: Format,
     result: Option<(serde_json::Value, Option<serde_json::Value>)>,

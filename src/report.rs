@@ -1,9 +1,9 @@
 //! Printing diagnostics: ariadne on a terminal, JSON for tools.
 
 use crate::Format;
-use btc_lang::diagnostic::Diagnostic;
-use btc_lang::render;
-use btc_lang::source::Sources;
+use btc_pddl::diagnostic::Diagnostic;
+use btc_pddl::render;
+use btc_pddl::source::Sources;
 use std::io::IsTerminal;
 
 fn use_color() -> bool {

@@ -2,10 +2,10 @@
 //! database.
 
 use crate::{files, report, Format};
+use btc_emit as emit;
 use btc_lang::db::{self, CompileJob, Database, SourceFile};
-use btc_lang::diagnostic::{has_errors, Diagnostic};
-use btc_lang::emit;
 use btc_lang::rules::{ImportTarget, Item};
+use btc_pddl::diagnostic::{has_errors, Diagnostic};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -233,7 +233,7 @@ pub fn fmt(paths: &[PathBuf], check: bool) -> anyhow::Result<ExitCode> {
     let mut failed = false;
     for path in paths {
         let mut diags = Vec::new();
-        let mut sources = btc_lang::source::Sources::new();
+        let mut sources = btc_pddl::source::Sources::new();
         let id = files::load(&mut sources, path, &mut diags)?;
         let text = sources.text(id).to_owned();
         match btc_lang::rules::fmt::format(&text) {
@@ -247,7 +247,7 @@ pub fn fmt(paths: &[PathBuf], check: bool) -> anyhow::Result<ExitCode> {
                         d
                     })
                     .collect();
-                eprint!("{}", btc_lang::render::to_terminal(&errs, &sources, false));
+                eprint!("{}", btc_pddl::render::to_terminal(&errs, &sources, false));
                 eprintln!("{}: not formatted: it does not parse", path.display());
                 failed = true;
             }

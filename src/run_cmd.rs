@@ -3,9 +3,9 @@
 
 use crate::{files, report, rules_cmd, Format};
 use btc_lang::db;
-use btc_lang::diagnostic::{has_errors, Diagnostic};
-use btc_lang::pipeline;
-use btc_lang::source::{FileId, Sources, Span};
+use btc_pddl::diagnostic::{has_errors, Diagnostic};
+use btc_pddl::pipeline;
+use btc_pddl::source::{FileId, Sources, Span};
 use btc_runtime::{Controller, Engine, Kb, LoadError, Options, Scenario, Summary, TreeDoc};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -137,7 +137,7 @@ fn run_rules(a: &RunArgs, rules: &Path, plan: &Path) -> anyhow::Result<ExitCode>
         }
     };
     let mut sources = database.sources();
-    let (Some(ir), Some(world)) = (ir, btc_runtime::JobWorld::of(&database, job)) else {
+    let (Some(ir), Some(world)) = (ir, btc_lang::db::JobWorld::of(&database, job)) else {
         return fail(&diags, &sources, a.format);
     };
     if a.format == Format::Text {
@@ -145,7 +145,18 @@ fn run_rules(a: &RunArgs, rules: &Path, plan: &Path) -> anyhow::Result<ExitCode>
     }
     let doc = TreeDoc::from_ir(ir);
     let anchor = db::file_id(&database, job.plan(&database));
-    execute(a, &doc, Some(world.kb()), &mut sources, anchor)
+    execute(
+        a,
+        &doc,
+        Some(btc_runtime::Kb::new(
+            world.domain,
+            world.dix,
+            world.problem,
+            world.pix,
+        )),
+        &mut sources,
+        anchor,
+    )
 }
 
 fn run_tree(a: &RunArgs, tree: &Path) -> anyhow::Result<ExitCode> {
@@ -303,7 +314,7 @@ fn print_summary(s: &Summary, commands: Option<usize>) {
 /// disk; diagnostics about a planned plan name it).
 const PLANNED: &str = "(planned).sas_plan";
 
-/// `btc run RULES --replan`: the closed loop of `btc_runtime::replan`.
+/// `btc run RULES --replan`: the closed loop of `btc_agent::replan`.
 fn run_replan(a: &RunArgs, rules: &Path) -> anyhow::Result<ExitCode> {
     if a.controller {
         anyhow::bail!("`--replan` runs the simulated world only; leave out `--controller`");
@@ -320,7 +331,7 @@ fn run_replan(a: &RunArgs, rules: &Path) -> anyhow::Result<ExitCode> {
         a.domain.as_deref(),
         &mut diags,
     )?;
-    if has_errors(&diags) || btc_runtime::JobWorld::of(&database, job).is_none() {
+    if has_errors(&diags) || btc_lang::db::JobWorld::of(&database, job).is_none() {
         return fail(&diags, &database.sources(), a.format);
     }
     // The scenario: read and parsed before the loop (its facts are checked
@@ -342,7 +353,7 @@ fn run_replan(a: &RunArgs, rules: &Path) -> anyhow::Result<ExitCode> {
         }
         None => None,
     };
-    let opts = btc_runtime::LoopOptions {
+    let opts = btc_agent::LoopOptions {
         engine: Options {
             ticks_per_action: a.ticks_per_action,
             ms_per_tick: if a.tick_ms > 0 { a.tick_ms } else { 10 },
@@ -352,7 +363,7 @@ fn run_replan(a: &RunArgs, rules: &Path) -> anyhow::Result<ExitCode> {
         max_replans: a.max_replans,
         max_ticks: a.max_ticks,
     };
-    let result = btc_runtime::run_loop(
+    let result = btc_agent::run_loop(
         &mut database,
         job,
         a.plan.is_some(),
@@ -362,15 +373,15 @@ fn run_replan(a: &RunArgs, rules: &Path) -> anyhow::Result<ExitCode> {
     let sources = database.sources();
     let summary = match result {
         Ok(s) => s,
-        Err(btc_runtime::LoopError::Compile(ds)) => {
+        Err(btc_agent::LoopError::Compile(ds)) => {
             diags.extend(ds);
             return fail(&diags, &sources, a.format);
         }
-        Err(btc_runtime::LoopError::Tree(e)) => {
+        Err(btc_agent::LoopError::Tree(e)) => {
             let anchor = db::file_id(&database, job.plan(&database));
             return fail(&[diagnostic(&e, anchor, &sources)], &sources, a.format);
         }
-        Err(btc_runtime::LoopError::Scenario(e)) => {
+        Err(btc_agent::LoopError::Scenario(e)) => {
             let f = scenario.map_or(0, |(_, f)| f);
             return fail(&[diagnostic(&e, f, &scen_sources)], &scen_sources, a.format);
         }
@@ -403,7 +414,7 @@ fn run_replan(a: &RunArgs, rules: &Path) -> anyhow::Result<ExitCode> {
 
 /// The loop's text summary (timings are in `--format json` only, so the
 /// text is the same from run to run).
-fn print_loop(s: &btc_runtime::LoopSummary) {
+fn print_loop(s: &btc_agent::LoopSummary) {
     for at in &s.attempts {
         let how = if at.source == "given" {
             "the given plan".to_owned()

@@ -1,9 +1,9 @@
 //! `btc validate DOMAIN PROBLEM PLAN`
 
 use crate::{files, report, Format};
-use btc_lang::diagnostic::has_errors;
-use btc_lang::pipeline::{domain_unit, plan_unit, problem_unit, validate_units};
-use btc_lang::source::Sources;
+use btc_pddl::diagnostic::has_errors;
+use btc_pddl::pipeline::{domain_unit, plan_unit, problem_unit, validate_units};
+use btc_pddl::source::Sources;
 use std::path::Path;
 use std::process::ExitCode;
 

@@ -53,7 +53,7 @@ const NO_FIXTURE: &[(&str, &str)] = &[(
 #[test]
 fn every_code_has_a_fixture() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/diagnostics");
-    for code in btc_lang::diagnostic::codes::ALL {
+    for code in btc_pddl::diagnostic::codes::ALL {
         if NO_FIXTURE.iter().any(|(c, _)| *c == code.id) {
             continue;
         }

@@ -13,7 +13,7 @@ fn diagnostic_reference_matches_the_code_list() {
                 .then(|| (cells[1].to_owned(), cells[3].to_owned()))
         })
         .collect();
-    let codes: Vec<(String, String)> = btc_lang::diagnostic::codes::ALL
+    let codes: Vec<(String, String)> = btc_pddl::diagnostic::codes::ALL
         .iter()
         .map(|c| (c.id.to_owned(), c.title.to_owned()))
         .collect();

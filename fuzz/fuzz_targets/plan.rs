@@ -5,9 +5,9 @@
 
 use std::sync::OnceLock;
 
-use btc_lang::pipeline::{domain_unit, plan_unit, problem_unit, validate_units, DomainUnit, ProblemUnit};
-use btc_lang::render::to_terminal;
-use btc_lang::source::{decode, Sources};
+use btc_pddl::pipeline::{domain_unit, plan_unit, problem_unit, validate_units, DomainUnit, ProblemUnit};
+use btc_pddl::render::to_terminal;
+use btc_pddl::source::{decode, Sources};
 use libfuzzer_sys::fuzz_target;
 
 const DOMAIN_PATH: &str = "examples/ariac/domain.pddl";

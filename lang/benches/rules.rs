@@ -4,16 +4,14 @@
 //! - check a 5,000-line rules file from scratch, and again after a one-rule
 //!   edit (the incremental path the language server takes).
 
+use btc_emit::{emit, Format, Options};
 use btc_lang::db::{compile, rules_diagnostics, CompileJob, Database};
-use btc_lang::emit::{emit, Format, Options};
 use divan::counter::ItemsCount;
 use divan::Bencher;
 
 // The same allocator as the `btc` binary.
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
-
-mod common;
 
 fn main() {
     divan::main();
@@ -26,7 +24,7 @@ const LARGE: &str = include_str!("../tests/fixtures/large.btrules");
 const STEPS: usize = 100_000;
 
 fn long_plan() -> String {
-    common::long_ariac_plan(STEPS)
+    btc_testkit::long_ariac_plan(STEPS)
 }
 
 #[divan::bench(sample_count = 10)]

@@ -3,13 +3,13 @@
 //! struct whose tree has item-relative spans, so an edit re-checks only the
 //! items it changed (see the tests at the end).
 
-use crate::diagnostic::{codes, Diagnostic};
-use crate::pddl::{ast::Domain, ast::Problem, DomainIndex, ProblemIndex};
-use crate::pipeline::{domain_unit_from, problem_unit_from};
 use crate::rules::check::{check_file, check_item, Decls, DomainCtx};
 use crate::rules::parse::{parse_item_text, parse_rules_with, shift};
 use crate::rules::{ImportTarget, Item, ItemNode, ParsedRules};
-use crate::source::{FileId, Sources, Span};
+use btc_pddl::diagnostic::{codes, Diagnostic};
+use btc_pddl::pipeline::{domain_unit_from, problem_unit_from};
+use btc_pddl::source::{FileId, Sources, Span};
+use btc_pddl::{ast::Domain, ast::Problem, DomainIndex, ProblemIndex};
 use salsa::plumbing::AsId;
 use salsa::Setter;
 use std::collections::BTreeMap;
@@ -503,6 +503,30 @@ pub fn own_items(db: &dyn Db, file: SourceFile) -> &[ItemNode] {
     &parsed_rules(db, file).items
 }
 
+/// The PDDL domain and problem of a compile job, checked, ready for a knowledge base or a validator.
+pub struct JobWorld<'db> {
+    pub domain: &'db btc_pddl::Domain,
+    pub dix: &'db btc_pddl::DomainIndex,
+    pub problem: &'db btc_pddl::Problem,
+    pub pix: &'db btc_pddl::ProblemIndex,
+}
+
+impl<'db> JobWorld<'db> {
+    /// `None` when the job has no usable domain or problem.
+    pub fn of(db: &'db Database, job: CompileJob) -> Option<JobWorld<'db>> {
+        let d = job_domain(db, job)?;
+        let p = job_problem(db, job)?;
+        let cd = checked_domain(db, d);
+        let cp = checked_problem(db, ProblemOf::new(db, p, d));
+        Some(JobWorld {
+            domain: cd.domain.as_ref()?,
+            dix: &cd.index,
+            problem: cp.problem.as_ref()?,
+            pix: &cp.index,
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -519,7 +543,7 @@ mod tests {
         let sources = db.sources();
         rules_diagnostics(db, f)
             .iter()
-            .map(|d| crate::render::to_short(d, &sources))
+            .map(|d| btc_pddl::render::to_short(d, &sources))
             .collect()
     }
 
@@ -649,21 +673,21 @@ pub fn job_diagnostics(db: &dyn Db, job: CompileJob) -> Vec<Diagnostic> {
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct TypedPlan {
-    pub plan: crate::plan::Plan,
-    pub steps: Vec<crate::plan::GroundStep>,
+    pub plan: btc_pddl::plan::Plan,
+    pub steps: Vec<btc_pddl::plan::GroundStep>,
     pub diagnostics: Vec<Diagnostic>,
 }
 
 #[salsa::tracked(returns(ref))]
 pub fn typed_plan(db: &dyn Db, job: CompileJob) -> TypedPlan {
     let pf = job.plan(db);
-    let (plan, mut diagnostics) = crate::plan::parse_plan(pf.text(db), file_id(db, pf));
+    let (plan, mut diagnostics) = btc_pddl::plan::parse_plan(pf.text(db), file_id(db, pf));
     let mut steps = Vec::new();
     if let (Some(d), Some(p)) = (job_domain(db, job), job_problem(db, job)) {
         let cd = checked_domain(db, d);
         let cp = checked_problem(db, ProblemOf::new(db, p, d));
         if let Some(domain) = &cd.domain {
-            let (s, diags) = crate::plan::type_plan(&plan, domain, &cd.index, &cp.index);
+            let (s, diags) = btc_pddl::plan::type_plan(&plan, domain, &cd.index, &cp.index);
             steps = s;
             diagnostics.extend(diags);
         }
@@ -678,9 +702,9 @@ pub fn typed_plan(db: &dyn Db, job: CompileJob) -> TypedPlan {
 /// Compiles a job to the tree IR, or returns why not (errors only; see
 /// [`job_diagnostics`] for warnings).
 #[salsa::tracked(returns(ref))]
-pub fn compile(db: &dyn Db, job: CompileJob) -> Result<crate::ir::TreeIr, Vec<Diagnostic>> {
+pub fn compile(db: &dyn Db, job: CompileJob) -> Result<btc_ir::TreeIr, Vec<Diagnostic>> {
     let diags = job_diagnostics(db, job);
-    if crate::diagnostic::has_errors(diags) {
+    if btc_pddl::diagnostic::has_errors(diags) {
         return Err(diags.iter().filter(|d| d.is_error()).cloned().collect());
     }
     let rules = job.rules(db);

@@ -1,21 +1,11 @@
-//! The btc compiler library.
+//! The `.btrules` language: its syntax, its checks against a PDDL domain,
+//! the salsa database that ties files together incrementally, and the
+//! lowering of rules and a typed plan into the tree IR ([`btc_ir`]).
 //!
-//! Layering is one-way: text ([`source`]) -> syntax ([`pddl::lexer`],
-//! [`pddl::sexpr`]) -> model ([`pddl::ast`], checked by [`pddl::check`]) ->
-//! plans ([`plan`]) -> simulation ([`validate`]). Nothing here prints or
-//! touches the file system except [`source::load`]; the CLI and the language
-//! server do the IO and render [`diagnostic::Diagnostic`] values.
+//! The PDDL front end is [`btc_pddl`]; the emitters are `btc-emit`. Nothing
+//! here prints or touches the file system: the CLI and the language server
+//! read files and hand their texts to [`db`].
 
 pub mod db;
-pub mod diagnostic;
-pub mod emit;
-pub mod ir;
 pub mod lower;
-pub mod pddl;
-pub mod pipeline;
-pub mod plan;
-pub mod render;
 pub mod rules;
-pub mod source;
-pub mod state;
-pub mod validate;

@@ -4,15 +4,15 @@
 //! and conditions are attached, and the `plan { ... }` template arranges the
 //! steps (`steps`, `steps backchained`, `steps parallel`).
 
-use crate::diagnostic::{codes, Diagnostic};
-use crate::ir::format_float;
-use crate::ir::*;
-use crate::pddl::ast::{Action, Domain, Effect, Formula, Problem, Term};
-use crate::pddl::check::{DomainIndex, ProblemIndex};
-use crate::plan::{GroundStep, Plan};
 use crate::rules::ast::*;
 use crate::rules::check::Decls;
 use crate::rules::matching::{match_args, match_name, Bindings, Captures, ObjectTypes};
+use btc_ir::format_float;
+use btc_ir::*;
+use btc_pddl::ast::{Action, Domain, Effect, Formula, Problem, Term};
+use btc_pddl::check::{DomainIndex, ProblemIndex};
+use btc_pddl::diagnostic::{codes, Diagnostic};
+use btc_pddl::plan::{GroundStep, Plan};
 use std::collections::{BTreeMap, BTreeSet};
 
 pub struct LowerInput<'a> {
@@ -117,7 +117,7 @@ fn mark_params<T: Clone + serde::Serialize + serde::de::DeserializeOwned>(
 }
 
 fn conj(parts: &[Formula]) -> Option<String> {
-    (!parts.is_empty()).then(|| crate::pddl::print::conjunction(parts))
+    (!parts.is_empty()).then(|| btc_pddl::print::conjunction(parts))
 }
 
 fn effs(parts: &[Effect]) -> Option<String> {
@@ -600,7 +600,7 @@ impl Inst<'_> {
                     // `{port}` inside a longer string, so a tree whose body
                     // interpolates its ports cannot be a shared <SubTree>.
                     self.used_trees.insert(name.text.clone());
-                    if self.depth >= crate::ir::MAX_CALL_DEPTH {
+                    if self.depth >= btc_ir::MAX_CALL_DEPTH {
                         return Vec::new();
                     }
                     let body = expand_tree(decl, args);
@@ -991,8 +991,8 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
             .init
             .iter()
             .filter_map(|f| match f {
-                crate::pddl::ast::InitFact::Atom { atom } => Some(atom.to_string()),
-                crate::pddl::ast::InitFact::Value { .. } => None,
+                btc_pddl::ast::InitFact::Atom { atom } => Some(atom.to_string()),
+                btc_pddl::ast::InitFact::Value { .. } => None,
             })
             .collect(),
         goal: input.problem.goal.as_ref().map(|g| g.to_string()),

@@ -1,8 +1,8 @@
 //! Rules files for corpus domains (`tests/corpus_rules/DOMAIN/`): each checks
 //! clean, and every corpus plan of its domain compiles through every emitter.
 
+use btc_emit::{emit, Format, Options};
 use btc_lang::db::{compile, rules_diagnostics, CompileJob, Database};
-use btc_lang::emit::{emit, Format, Options};
 use std::path::{Path, PathBuf};
 
 fn repo() -> PathBuf {

@@ -1,10 +1,10 @@
 //! `steps parallel`: every order of steps that the parallel tree allows
 //! (chains in order, `WaitForStep` edges respected) is a valid plan.
 
+use btc_ir::{Node, PortValue, TreeIr};
 use btc_lang::db::{compile, CompileJob, Database};
-use btc_lang::ir::{Node, PortValue, TreeIr};
-use btc_lang::pipeline::{domain_unit, plan_unit, problem_unit, validate_units};
-use btc_lang::source::Sources;
+use btc_pddl::pipeline::{domain_unit, plan_unit, problem_unit, validate_units};
+use btc_pddl::source::Sources;
 use std::path::Path;
 
 fn root() -> &'static Path {

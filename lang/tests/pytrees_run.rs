@@ -5,13 +5,13 @@
 //!
 //! Needs `python3` with py_trees 2.2 or later (`pip install py_trees`).
 
-use btc_lang::db::{compile, CompileJob, Database};
-use btc_lang::emit::pytrees;
-use btc_lang::ir::{
+use btc_emit::pytrees;
+use btc_ir::{ControlKind, DecoratorKind};
+use btc_ir::{
     LeafKind, Node, NodeModel, Port, PortDirection, PortModel, PortValue, StepInfo, TreeDef,
     TreeIr, IR_VERSION,
 };
-use btc_lang::rules::ast::{ControlKind, DecoratorKind};
+use btc_lang::db::{compile, CompileJob, Database};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 

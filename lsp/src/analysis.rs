@@ -6,11 +6,11 @@ use crate::syntax::FileSyntax;
 use crate::syntax::Tokens;
 use crate::workspace::Workspace;
 use btc_lang::db::{checked_domain, declarations, import_closure, parsed_rules, SourceFile};
-use btc_lang::pddl::ast::{Action, Domain};
-use btc_lang::pddl::DomainIndex;
 use btc_lang::rules::ast::{Item, ItemNode, Rule};
 use btc_lang::rules::check::{matched_actions, Decls};
-use btc_lang::source::Span;
+use btc_pddl::ast::{Action, Domain};
+use btc_pddl::source::Span;
+use btc_pddl::DomainIndex;
 use tower_lsp::lsp_types::{Location, Range, Url};
 
 pub struct Analysis<'a> {

@@ -1,7 +1,7 @@
 //! Byte offsets (what btc's spans hold) to LSP positions (lines and UTF-16
 //! columns) and back. The only place that knows about UTF-16.
 
-use btc_lang::source::Span;
+use btc_pddl::source::Span;
 use tower_lsp::lsp_types::{Position, Range};
 
 /// Line starts of one text, for converting positions both ways.

@@ -4,10 +4,10 @@
 use crate::analysis::Analysis;
 use crate::convert::LineIndex;
 use btc_lang::db::{import_closure, parsed_rules, rules_diagnostics};
-use btc_lang::diagnostic::Diagnostic;
-use btc_lang::pddl::ast::{Action, TypeSpec};
 use btc_lang::rules::ast::Item;
 use btc_lang::rules::matching::match_name;
+use btc_pddl::ast::{Action, TypeSpec};
+use btc_pddl::diagnostic::Diagnostic;
 use std::collections::HashMap;
 use tower_lsp::lsp_types::{
     CodeAction, CodeActionKind, Position, Range, TextEdit, Url, WorkspaceEdit,

@@ -4,7 +4,7 @@ use crate::analysis::{shift, Analysis};
 use crate::syntax::Symbol;
 use btc_lang::rules::ast::Item;
 use btc_lang::rules::lexer::Tok;
-use btc_lang::source::Span;
+use btc_pddl::source::Span;
 use tower_lsp::lsp_types::{
     InlayHint, InlayHintKind, InlayHintLabel, Range, SemanticToken, SemanticTokenType,
     SemanticTokensLegend,

@@ -4,7 +4,7 @@ use crate::analysis::{shift, Analysis, Place};
 use crate::syntax::Symbol;
 use btc_lang::db::file_id;
 use btc_lang::rules::ast::{Item, NodeKind};
-use btc_lang::source::Span;
+use btc_pddl::source::Span;
 use std::collections::HashMap;
 use tower_lsp::lsp_types::{
     Hover, HoverContents, Location, MarkupContent, MarkupKind, TextEdit, Url, WorkspaceEdit,

@@ -6,7 +6,7 @@ use crate::analysis::Analysis;
 use crate::convert::LineIndex;
 use crate::workspace::{FileDiagnostics, Workspace};
 use crate::{completion, edits, highlight, navigation, symbols};
-use btc_lang::diagnostic::{Diagnostic, Severity};
+use btc_pddl::diagnostic::{Diagnostic, Severity};
 use std::sync::{Arc, Mutex, MutexGuard};
 use tower_lsp::jsonrpc::{Error, Result};
 use tower_lsp::lsp_types::*;

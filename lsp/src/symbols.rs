@@ -2,7 +2,7 @@
 
 use crate::analysis::{shift, Analysis, Place};
 use btc_lang::rules::ast::{ImportTarget, Item};
-use btc_lang::source::Span;
+use btc_pddl::source::Span;
 use tower_lsp::lsp_types::{DocumentSymbol, SymbolInformation, SymbolKind};
 
 /// One symbol of a rules file: name, kind, the whole item and its name.

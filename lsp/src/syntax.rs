@@ -3,11 +3,11 @@
 //! they parsed). Hover, go-to-definition, references, rename, completion
 //! and semantic tokens all start here.
 
-use btc_lang::pddl::DomainIndex;
 use btc_lang::rules::ast::{Item, ItemNode, NamePart};
 use btc_lang::rules::check::Decls;
 use btc_lang::rules::lexer::{lex, Comment, Tok};
-use btc_lang::source::Span;
+use btc_pddl::source::Span;
+use btc_pddl::DomainIndex;
 
 /// Item keywords: a name after one of these is being declared.
 pub const DECL_KEYWORDS: &[&str] = &["action", "condition", "tree", "table"];

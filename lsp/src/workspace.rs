@@ -8,8 +8,8 @@ use btc_lang::db::{
     checked_domain, checked_problem, domain_file, file_id, normalize, parsed_rules, problem_file,
     rules_diagnostics, Database, Db as _, ProblemOf, SourceFile,
 };
-use btc_lang::diagnostic::Diagnostic;
 use btc_lang::rules::{ImportTarget, Item};
+use btc_pddl::diagnostic::Diagnostic;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 use tower_lsp::lsp_types::TextDocumentContentChangeEvent;
@@ -180,7 +180,7 @@ impl Workspace {
     }
 
     /// The path of a file id.
-    pub fn path_of(&self, id: btc_lang::source::FileId) -> Option<String> {
+    pub fn path_of(&self, id: btc_pddl::source::FileId) -> Option<String> {
         self.db
             .workspace()
             .files(&self.db)
@@ -194,7 +194,7 @@ impl Workspace {
     /// diagnostics last time and have none now get an empty list.
     pub fn diagnostics(&mut self) -> Vec<FileDiagnostics> {
         let mut by_path: BTreeMap<String, Vec<Diagnostic>> = BTreeMap::new();
-        let mut ids: BTreeMap<btc_lang::source::FileId, String> = BTreeMap::new();
+        let mut ids: BTreeMap<btc_pddl::source::FileId, String> = BTreeMap::new();
         for (p, f) in self.db.workspace().files(&self.db) {
             ids.insert(file_id(&self.db, *f), p.clone());
         }
@@ -288,5 +288,5 @@ fn read(path: &Path) -> Option<String> {
         return None;
     }
     let bytes = std::fs::read(path).ok()?;
-    Some(btc_lang::source::decode(&bytes).0)
+    Some(btc_pddl::source::decode(&bytes).0)
 }

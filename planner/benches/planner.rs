@@ -11,8 +11,8 @@
 //! a table for A* with LM-cut and with h_max (60 s limit per problem, so
 //! several minutes).
 
-use btc_lang::pipeline::{domain_unit, problem_unit, DomainUnit, ProblemUnit};
-use btc_lang::source::Sources;
+use btc_pddl::pipeline::{domain_unit, problem_unit, DomainUnit, ProblemUnit};
+use btc_pddl::source::Sources;
 use btc_planner::{Algorithm, Heuristic, Options, Outcome};
 use divan::Bencher;
 use std::path::{Path, PathBuf};
@@ -78,7 +78,7 @@ fn load(name: &str) -> Loaded {
     } else {
         dir.join("domain.pddl")
     };
-    let read = |p: &Path| btc_lang::source::decode(&std::fs::read(p).unwrap()).0;
+    let read = |p: &Path| btc_pddl::source::decode(&std::fs::read(p).unwrap()).0;
     units(&read(&d), &read(&dir.join(format!("{prob}.pddl"))))
 }
 

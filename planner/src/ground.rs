@@ -6,11 +6,11 @@
 
 use crate::lifted::*;
 use crate::task::{Axiom, GroundEffect, Lit, Operator, Task};
-use btc_lang::diagnostic::{codes, Diagnostic};
-use btc_lang::pddl::ast::{Domain, Formula, NumOp};
-use btc_lang::pddl::check::{DomainIndex, ProblemIndex};
-use btc_lang::source::Span;
-use btc_lang::state::State;
+use btc_pddl::ast::{Domain, Formula, NumOp};
+use btc_pddl::check::{DomainIndex, ProblemIndex};
+use btc_pddl::diagnostic::{codes, Diagnostic};
+use btc_pddl::source::Span;
+use btc_pddl::state::State;
 use rustc_hash::{FxHashMap, FxHashSet};
 use std::cell::Cell;
 use std::time::Instant;

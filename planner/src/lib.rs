@@ -7,8 +7,8 @@
 //! what replanning needs. Nothing here prints.
 //!
 //! ```
-//! use btc_lang::pipeline::{domain_unit_from, problem_unit_from};
-//! use btc_lang::state::World;
+//! use btc_pddl::pipeline::{domain_unit_from, problem_unit_from};
+//! use btc_pddl::state::World;
 //! use btc_planner::{plan_from, to_sas_plan, Options, Outcome};
 //!
 //! let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/ariac/");
@@ -47,10 +47,10 @@ pub use ground::GroundStats;
 pub use heuristic::Heuristic;
 pub use search::{Algorithm, Options, SearchStats};
 
-use btc_lang::diagnostic::{codes, Diagnostic};
-use btc_lang::pddl::ast::{Domain, Formula, InitFact, Problem};
-use btc_lang::pddl::check::{DomainIndex, ProblemIndex};
-use btc_lang::state::{State, World};
+use btc_pddl::ast::{Domain, Formula, InitFact, Problem};
+use btc_pddl::check::{DomainIndex, ProblemIndex};
+use btc_pddl::diagnostic::{codes, Diagnostic};
+use btc_pddl::state::{State, World};
 use std::time::{Duration, Instant};
 
 /// One step of a plan: an action of the domain and its arguments (object
@@ -228,8 +228,8 @@ pub fn timeout(problem: &Problem, limit: Duration) -> Diagnostic {
 
 #[cfg(test)]
 pub(crate) mod test_util {
-    use btc_lang::pipeline::{domain_unit_from, problem_unit_from};
-    use btc_lang::state::World;
+    use btc_pddl::pipeline::{domain_unit_from, problem_unit_from};
+    use btc_pddl::state::World;
 
     /// The ground task of a domain and problem text (fixtures from
     /// `tests/fixtures/`).

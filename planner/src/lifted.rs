@@ -4,15 +4,15 @@
 //! of objects that fit. Features the planner cannot handle are refused here
 //! with a diagnostic naming them.
 
-use btc_lang::diagnostic::{codes, Diagnostic};
-use btc_lang::pddl::ast::*;
-use btc_lang::pddl::check::{DomainIndex, ProblemIndex};
-use btc_lang::pddl::types::TypeId;
-use btc_lang::source::Span;
+use btc_pddl::ast::*;
+use btc_pddl::check::{DomainIndex, ProblemIndex};
+use btc_pddl::diagnostic::{codes, Diagnostic};
+use btc_pddl::source::Span;
+use btc_pddl::types::TypeId;
 use rustc_hash::FxHashMap;
 use std::rc::Rc;
 
-/// Ground atoms are keys `[predicate, objects...]`, as in `btc_lang::state`;
+/// Ground atoms are keys `[predicate, objects...]`, as in `btc_pddl::state`;
 /// the planner builds them in a fixed buffer, so arity is bounded.
 pub const MAX_ARITY: usize = 15;
 

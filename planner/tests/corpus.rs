@@ -163,7 +163,7 @@ fn lm_cut_lies_between_h_max_and_the_optimal_cost() {
     if btc_testkit::corpus().is_none() {
         return;
     }
-    use btc_lang::state::World;
+    use btc_pddl::state::World;
     use btc_planner::heuristic::Evaluator;
     let optimal = optimal_domains();
     let mut checked = 0;

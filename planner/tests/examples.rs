@@ -4,7 +4,7 @@
 
 mod common;
 
-use btc_lang::state::World;
+use btc_pddl::state::World;
 use btc_planner::{Algorithm, Heuristic, Options, Outcome};
 use common::*;
 use std::path::PathBuf;

@@ -8,8 +8,8 @@
 //!
 //! After divan's table, `main` prints the per-leaf figures directly.
 
-use btc_lang::ir::{LeafKind, PortValue};
-use btc_lang::pipeline;
+use btc_ir::{LeafKind, PortValue};
+use btc_pddl::pipeline;
 use btc_runtime::spec::{Kind, SNode, TreeDoc};
 use btc_runtime::{xml, Engine, Kb, Options, Status};
 use divan::counter::ItemsCount;

@@ -9,8 +9,8 @@ use crate::error::LoadError;
 use crate::faults::FaultRt;
 use crate::kb::{substitute, EffectId, FormulaId, Kb};
 use crate::spec::{default_name, Kind, SNode, TreeDoc};
-use btc_lang::diagnostic::{codes, did_you_mean};
-use btc_lang::ir::{LeafKind, PortValue};
+use btc_ir::{LeafKind, PortValue};
+use btc_pddl::diagnostic::{codes, did_you_mean};
 use rustc_hash::FxHashMap;
 use serde::Serialize;
 use std::rc::Rc;
@@ -79,7 +79,7 @@ impl Value {
             Value::Empty => String::new(),
             Value::Text(s) => s.to_string(),
             Value::Int(n) => n.to_string(),
-            Value::Float(f) => btc_lang::ir::format_float(*f),
+            Value::Float(f) => btc_ir::format_float(*f),
             Value::Bool(b) => b.to_string(),
         }
     }
@@ -1287,7 +1287,7 @@ const BUILTIN_LEAVES: &[&str] = &[
 ];
 
 impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
-    fn err(&self, code: btc_lang::diagnostic::Code, n: &SNode, msg: String) -> LoadError {
+    fn err(&self, code: btc_pddl::diagnostic::Code, n: &SNode, msg: String) -> LoadError {
         LoadError::new(code, msg).at_opt(n.at)
     }
 
@@ -1549,9 +1549,8 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
                 .position(|p| p.name.name == v)
                 .map(|i| args[i].clone())
         };
-        let text = |parts: &[btc_lang::pddl::ast::Formula]| {
-            (!parts.is_empty())
-                .then(|| substitute(&btc_lang::pddl::print::conjunction(parts), bind))
+        let text = |parts: &[btc_pddl::ast::Formula]| {
+            (!parts.is_empty()).then(|| substitute(&btc_pddl::print::conjunction(parts), bind))
         };
         let (pre_start, over_all, pre_end) =
             (text(&a.pre_start), text(&a.pre_over_all), text(&a.pre_end));

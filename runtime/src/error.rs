@@ -2,7 +2,7 @@
 //! the user's terms, where in the file (a byte offset) and a hint. The CLI
 //! turns them into diagnostics and renders them.
 
-use btc_lang::diagnostic::Code;
+use btc_pddl::diagnostic::Code;
 use std::fmt;
 
 #[derive(Clone, Debug, PartialEq)]

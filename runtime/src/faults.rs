@@ -4,8 +4,8 @@
 use crate::engine::{Engine, Reason, Status, TraceItem};
 use crate::error::LoadError;
 use crate::kb::FormulaId;
-use btc_lang::diagnostic::codes;
-use btc_lang::state::Key;
+use btc_pddl::diagnostic::codes;
+use btc_pddl::state::Key;
 use serde::{Deserialize, Serialize};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -164,7 +164,7 @@ impl Scenario {
                     kind_name
                 ));
                 e = e.hint(
-                    btc_lang::diagnostic::did_you_mean(&kind_name, names.iter().copied())
+                    btc_pddl::diagnostic::did_you_mean(&kind_name, names.iter().copied())
                         .unwrap_or_else(|| format!("the kinds are {}", names.join(", "))),
                 );
                 e
@@ -241,7 +241,7 @@ impl Scenario {
 }
 
 /// A fault at run time.
-pub(crate) struct FaultRt {
+pub struct FaultRt {
     pub spec: FaultSpec,
     pub met_at: Option<u64>,
     /// The tick at which its effect ends.
@@ -431,7 +431,7 @@ impl<'w> Engine<'w> {
     /// faults): replanning moves it to the next plan's engine, so a fault
     /// that fired does not fire again. Call after [`Engine::trace_jsonl`]:
     /// the trace names faults by their place in this list.
-    pub(crate) fn take_faults(&mut self) -> Vec<FaultRt> {
+    pub fn take_faults(&mut self) -> Vec<FaultRt> {
         let v = std::mem::take(&mut self.faults);
         self.refresh_live();
         v
@@ -439,7 +439,7 @@ impl<'w> Engine<'w> {
 
     /// Puts faults taken from an earlier engine into this one; the goals
     /// of faults still to come are re-read in this engine's KB.
-    pub(crate) fn restore_faults(&mut self, mut faults: Vec<FaultRt>) {
+    pub fn restore_faults(&mut self, mut faults: Vec<FaultRt>) {
         for rt in &mut faults {
             rt.goal = match (&rt.spec.goal, self.kb.as_mut()) {
                 (Some(g), Some(kb)) => kb.formula(g).ok(),
@@ -656,7 +656,7 @@ impl<'w> Engine<'w> {
 
 /// The met faults that removed or added a fact `text` shows, or whose part
 /// or robot it names (`text`: a goal literal): their labels.
-pub(crate) fn naming(faults: &[FaultRt], text: &str) -> Vec<String> {
+pub fn naming(faults: &[FaultRt], text: &str) -> Vec<String> {
     let words: Vec<&str> = text
         .split(|c: char| c.is_whitespace() || c == '(' || c == ')')
         .filter(|w| !w.is_empty())

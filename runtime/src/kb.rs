@@ -1,10 +1,10 @@
 //! The simulated world's knowledge base: a PDDL state (from the problem's
 //! `:init`) with the formulas and effects the tree refers to, parsed once.
-//! The semantics are `btc_lang::state`'s, the validator's.
+//! The semantics are `btc_pddl::state`'s, the validator's.
 
-use btc_lang::pddl::ast::{Domain, Effect, Formula, Problem};
-use btc_lang::pddl::{lexer, parse, sexpr, DomainIndex, ProblemIndex};
-use btc_lang::state::{Changes, Env, Key, State, World};
+use btc_pddl::ast::{Domain, Effect, Formula, Problem};
+use btc_pddl::state::{Changes, Env, Key, State, World};
+use btc_pddl::{lexer, parse, sexpr, DomainIndex, ProblemIndex};
 use rustc_hash::FxHashMap;
 
 /// Index of a parsed formula or effect in a [`Kb`].
@@ -121,7 +121,7 @@ impl<'w> Kb<'w> {
             return Err(d.message.clone());
         }
         let f = f.ok_or_else(|| "not a PDDL condition".to_owned())?;
-        let diags = btc_lang::pddl::check::check_formula_in(
+        let diags = btc_pddl::check::check_formula_in(
             self.world.domain,
             self.world.dix,
             Some(self.world.pix),
@@ -151,7 +151,7 @@ impl<'w> Kb<'w> {
             return Err(d.message.clone());
         }
         let e = e.ok_or_else(|| "not a PDDL effect".to_owned())?;
-        let diags = btc_lang::pddl::check::check_effect_in(
+        let diags = btc_pddl::check::check_effect_in(
             self.world.domain,
             self.world.dix,
             Some(self.world.pix),
@@ -295,7 +295,7 @@ impl<'w> Kb<'w> {
             format!(
                 "(= {} {})",
                 self.world.show_fluent(k),
-                btc_lang::ir::format_float(*x)
+                btc_ir::format_float(*x)
             )
         }));
         v.sort();
@@ -364,7 +364,7 @@ pub fn substitute(text: &str, value: impl Fn(&str) -> Option<String>) -> String 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use btc_lang::pipeline;
+    use btc_pddl::pipeline;
 
     #[test]
     fn ground_literals_take_the_fast_path_with_the_same_answers() {

@@ -13,7 +13,6 @@ pub mod engine;
 pub mod error;
 pub mod faults;
 pub mod kb;
-pub mod replan;
 pub mod spec;
 pub mod xml;
 
@@ -22,7 +21,6 @@ pub use engine::{Engine, FaultRecord, Options, Status, Value};
 pub use error::LoadError;
 pub use faults::{FaultKind, FaultOutcome, Scenario};
 pub use kb::Kb;
-pub use replan::{run_loop, LoopError, LoopOptions, LoopSummary};
 pub use spec::TreeDoc;
 
 use serde::Serialize;
@@ -69,47 +67,15 @@ impl<'w> Engine<'w> {
 
 /// Reads a tree file: BT.CPP XML when it starts with `<`, btc's JSON IR
 /// when it starts with `{`. The IR comes back too (it names its problem).
-pub fn load_tree(text: &str) -> Result<(TreeDoc, Option<btc_lang::ir::TreeIr>), LoadError> {
+pub fn load_tree(text: &str) -> Result<(TreeDoc, Option<btc_ir::TreeIr>), LoadError> {
     match text.trim_start().chars().next() {
         Some('<') => xml::parse(text).map(|d| (d, None)),
         Some('{') => TreeDoc::from_json(text).map(|(d, ir)| (d, Some(ir))),
         _ => Err(LoadError::new(
-            btc_lang::diagnostic::codes::X_TREE_SYNTAX,
+            btc_pddl::diagnostic::codes::X_TREE_SYNTAX,
             "this is neither BT.CPP XML nor btc's JSON tree IR",
         )
         .at(0)
         .hint("give a file written by `btc compile --emit btcpp` or `--emit json`, or by Groot2")),
-    }
-}
-
-/// The PDDL domain and problem of a compile job, checked, ready for a [`Kb`].
-pub struct JobWorld<'db> {
-    pub domain: &'db btc_lang::pddl::Domain,
-    pub dix: &'db btc_lang::pddl::DomainIndex,
-    pub problem: &'db btc_lang::pddl::Problem,
-    pub pix: &'db btc_lang::pddl::ProblemIndex,
-}
-
-impl<'db> JobWorld<'db> {
-    /// `None` when the job has no usable domain or problem.
-    pub fn of(
-        db: &'db btc_lang::db::Database,
-        job: btc_lang::db::CompileJob,
-    ) -> Option<JobWorld<'db>> {
-        use btc_lang::db;
-        let d = db::job_domain(db, job)?;
-        let p = db::job_problem(db, job)?;
-        let cd = db::checked_domain(db, d);
-        let cp = db::checked_problem(db, db::ProblemOf::new(db, p, d));
-        Some(JobWorld {
-            domain: cd.domain.as_ref()?,
-            dix: &cd.index,
-            problem: cp.problem.as_ref()?,
-            pix: &cp.index,
-        })
-    }
-
-    pub fn kb(&self) -> Kb<'db> {
-        Kb::new(self.domain, self.dix, self.problem, self.pix)
     }
 }

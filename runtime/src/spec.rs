@@ -2,9 +2,9 @@
 //! both produce, so the two run through one builder (and give one trace).
 
 use crate::error::LoadError;
-use btc_lang::diagnostic::codes;
-use btc_lang::ir::{LeafKind, Node, NodeModel, PortValue, StepInfo, TreeIr};
-use btc_lang::rules::ast::{ControlKind, DecoratorKind};
+use btc_ir::{ControlKind, DecoratorKind};
+use btc_ir::{LeafKind, Node, NodeModel, PortValue, StepInfo, TreeIr};
+use btc_pddl::diagnostic::codes;
 
 /// What a node does. Thresholds and counts are BT.CPP's: `-1` means "all
 /// children" (Parallel) or "forever" (Retry, Repeat).
@@ -113,7 +113,7 @@ fn line_col_offset(text: &str, line: usize, col: usize) -> usize {
     (start + col.saturating_sub(1)).min(text.len())
 }
 
-fn ports(ps: &[btc_lang::ir::Port]) -> Vec<(String, PortValue)> {
+fn ports(ps: &[btc_ir::Port]) -> Vec<(String, PortValue)> {
     ps.iter()
         .map(|p| (p.name.clone(), p.value.clone()))
         .collect()

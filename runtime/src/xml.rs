@@ -6,8 +6,8 @@
 use crate::engine::MAX_DEPTH;
 use crate::error::LoadError;
 use crate::spec::{Kind, SNode, TreeDoc};
-use btc_lang::diagnostic::codes;
-use btc_lang::ir::{LeafKind, NodeModel, PortDirection, PortModel, PortValue};
+use btc_ir::{LeafKind, NodeModel, PortDirection, PortModel, PortValue};
+use btc_pddl::diagnostic::codes;
 use quick_xml::events::{BytesStart, Event};
 use quick_xml::Reader;
 

@@ -1,7 +1,7 @@
 //! The queued controller: every command issued is executed exactly once, in
 //! order, also under load with a tiny queue; shutdown is clean.
 
-use btc_lang::ir::LeafKind;
+use btc_ir::LeafKind;
 use btc_runtime::spec::{Kind, SNode, TreeDoc};
 use btc_runtime::{Command, Controller, Engine, Options, Status};
 use std::time::Duration;
@@ -44,7 +44,7 @@ fn leaf(i: usize) -> SNode {
         kind: Kind::Leaf {
             id: "Work".into(),
             kind: Some(LeafKind::Action),
-            ports: vec![("n".into(), btc_lang::ir::PortValue::Int(i as i64))],
+            ports: vec![("n".into(), btc_ir::PortValue::Int(i as i64))],
         },
         name: Some(format!("work {i}")),
         children: Vec::new(),
@@ -131,7 +131,7 @@ fn halted_leaves_commands_still_run_once_and_are_not_waited_for() {
         kind: Kind::Leaf {
             id: "Sleep".into(),
             kind: None,
-            ports: vec![("msec".into(), btc_lang::ir::PortValue::Int(10))],
+            ports: vec![("msec".into(), btc_ir::PortValue::Int(10))],
         },
         name: None,
         children: Vec::new(),

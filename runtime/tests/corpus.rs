@@ -3,8 +3,9 @@
 //! from the IR and from the BT.CPP XML written for it, with the same trace.
 
 mod common;
+use btc_lang::db::JobWorld;
 use btc_lang::db::{compile, CompileJob, Database};
-use btc_runtime::{xml, Engine, JobWorld, Status, TreeDoc};
+use btc_runtime::{xml, Engine, Status, TreeDoc};
 use common::{root, traced};
 use std::path::{Path, PathBuf};
 
@@ -54,11 +55,15 @@ fn corpus_plans_run_to_their_goal() {
                 .unwrap_or_else(|e| panic!("{}: {e:#?}", plan.display()));
             let w = JobWorld::of(&db, job).unwrap();
             let what = plan.display().to_string();
-            let xml_text = btc_lang::emit::btcpp::emit(&ir, false);
+            let xml_text = btc_emit::btcpp::emit(&ir, false);
             let mut traces = Vec::new();
             for doc in [TreeDoc::from_ir(&ir), xml::parse(&xml_text).unwrap()] {
-                let mut e = Engine::build(&doc, Some(w.kb()), traced())
-                    .unwrap_or_else(|e| panic!("{what}: {e}"));
+                let mut e = Engine::build(
+                    &doc,
+                    Some(btc_runtime::Kb::new(w.domain, w.dix, w.problem, w.pix)),
+                    traced(),
+                )
+                .unwrap_or_else(|e| panic!("{what}: {e}"));
                 let s = e.run(1_000_000, |_| {});
                 let sum = e.summary(s);
                 assert_eq!(s, Status::Success, "{what}: {:#?}", sum.records);

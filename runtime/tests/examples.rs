@@ -60,7 +60,7 @@ fn btcpp_xml_runs_exactly_like_its_ir() {
                 TreeDoc::from_ir(&ex.ir)
             };
             from_ir.steps = ex.ir.steps.clone();
-            let text = btc_lang::emit::btcpp::emit(&ex.ir, inline);
+            let text = btc_emit::btcpp::emit(&ex.ir, inline);
             // The XML carries the steps' effects; their conditions come
             // from the domain's actions, as `btc run --tree` does.
             let from_xml = xml::parse(&text).unwrap_or_else(|e| panic!("{name}: {e}"));
@@ -97,7 +97,7 @@ fn xml_steps_check_the_domain_preconditions_like_the_ir() {
     // plan given) must fail where the IR fails, with the same record.
     let ex = example("ariac");
     let w = ex.world();
-    let text = btc_lang::emit::btcpp::emit(&ex.ir, false);
+    let text = btc_emit::btcpp::emit(&ex.ir, false);
     let sc_text =
         std::fs::read_to_string(root().join("examples/ariac/faults/faulty_part.toml")).unwrap();
     let sc = btc_runtime::Scenario::parse(&sc_text).unwrap();

@@ -4,7 +4,7 @@
 //! sources (`controls/*.cpp`, `decorators/*.cpp`).
 
 mod common;
-use btc_lang::pipeline::{self, DomainUnit, ProblemUnit};
+use btc_pddl::pipeline::{self, DomainUnit, ProblemUnit};
 use btc_runtime::engine::TraceItem;
 use btc_runtime::{xml, Engine, Kb, Options, Status, Value};
 use common::fixture;

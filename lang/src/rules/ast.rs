@@ -2,8 +2,9 @@
 //! own start (see [`ItemNode::offset`]), so editing one item leaves the
 //! others' trees equal — the incremental checker relies on that.
 
-use crate::pddl::ast::{Effect, Formula};
-use crate::source::Span;
+pub use btc_ir::{ControlKind, DecoratorKind};
+use btc_pddl::ast::{Effect, Formula};
+use btc_pddl::source::Span;
 use serde::{Deserialize, Serialize};
 
 /// A name as written (case kept: node names are CamelCase).
@@ -238,52 +239,6 @@ pub struct Rule {
     pub guards: Vec<Guard>,
     pub body: RuleBody,
     pub span: Span,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "kebab-case")]
-pub enum ControlKind {
-    Sequence,
-    ReactiveSequence,
-    Fallback,
-    ReactiveFallback,
-    Parallel { success: u32, failure: u32 },
-}
-
-impl ControlKind {
-    pub fn keyword(self) -> &'static str {
-        match self {
-            ControlKind::Sequence => "sequence",
-            ControlKind::ReactiveSequence => "reactive_sequence",
-            ControlKind::Fallback => "fallback",
-            ControlKind::ReactiveFallback => "reactive_fallback",
-            ControlKind::Parallel { .. } => "parallel",
-        }
-    }
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "kebab-case")]
-pub enum DecoratorKind {
-    Retry { times: u32 },
-    Repeat { times: u32 },
-    Timeout { ms: u64 },
-    Inverter,
-    ForceSuccess,
-    ForceFailure,
-}
-
-impl DecoratorKind {
-    pub fn keyword(self) -> &'static str {
-        match self {
-            DecoratorKind::Retry { .. } => "retry",
-            DecoratorKind::Repeat { .. } => "repeat",
-            DecoratorKind::Timeout { .. } => "timeout",
-            DecoratorKind::Inverter => "inverter",
-            DecoratorKind::ForceSuccess => "force_success",
-            DecoratorKind::ForceFailure => "force_failure",
-        }
-    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]

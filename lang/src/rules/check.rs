@@ -5,11 +5,11 @@
 
 use super::ast::*;
 use super::matching::{bind_params, match_name};
-use crate::diagnostic::{closest, codes, Diagnostic};
-use crate::pddl::ast::{Domain, Effect, Formula};
-use crate::pddl::check::{check_effect_in, check_formula_in, DomainIndex, ProblemIndex};
-use crate::pddl::types::TypeId;
-use crate::source::{FileId, Span};
+use btc_pddl::ast::{Domain, Effect, Formula};
+use btc_pddl::check::{check_effect_in, check_formula_in, DomainIndex, ProblemIndex};
+use btc_pddl::diagnostic::{closest, codes, Diagnostic};
+use btc_pddl::source::{FileId, Span};
+use btc_pddl::types::TypeId;
 use std::collections::{BTreeMap, BTreeSet};
 
 /// Declarations visible in a rules file: its own, its imports' and the
@@ -495,7 +495,7 @@ impl Tcx<'_> {
 /// Variables of a rule pattern typed by one PDDL action's parameters.
 fn rule_vars(
     rule: &Rule,
-    action: Option<(&crate::pddl::ast::Action, &DomainCtx)>,
+    action: Option<(&btc_pddl::ast::Action, &DomainCtx)>,
 ) -> Vec<(String, Option<Vec<TypeId>>)> {
     let mut vars: Vec<(String, Option<Vec<TypeId>>)> = Vec::new();
     for (i, p) in rule.pattern.params.iter().enumerate() {
@@ -525,7 +525,7 @@ fn rule_vars(
 pub fn matched_actions<'d>(
     pattern: &Pattern,
     domain: &'d Domain,
-) -> Vec<(&'d crate::pddl::ast::Action, Vec<(String, String)>)> {
+) -> Vec<(&'d btc_pddl::ast::Action, Vec<(String, String)>)> {
     domain
         .actions
         .iter()
@@ -539,7 +539,7 @@ pub fn rule_actions<'d>(
     r: &Rule,
     decls: &Decls,
     domain: &'d Domain,
-) -> Vec<(&'d crate::pddl::ast::Action, Vec<(String, String)>)> {
+) -> Vec<(&'d btc_pddl::ast::Action, Vec<(String, String)>)> {
     matched_actions(&r.pattern, domain)
         .into_iter()
         .filter(|(_, caps)| {
@@ -564,8 +564,7 @@ fn scope_of(vars: &[(String, Option<Vec<TypeId>>)]) -> Vec<(String, Vec<TypeId>)
         .map(|(v, t)| {
             (
                 v.clone(),
-                t.clone()
-                    .unwrap_or_else(|| vec![crate::pddl::types::OBJECT]),
+                t.clone().unwrap_or_else(|| vec![btc_pddl::types::OBJECT]),
             )
         })
         .collect()
@@ -789,7 +788,7 @@ fn check_rule(r: &Rule, decls: &Decls, ctx: Option<DomainCtx>) -> Vec<Diagnostic
             _ => {}
         }
     }
-    let captures_of = |matched: &[(&crate::pddl::ast::Action, Vec<(String, String)>)]| -> Vec<(String, Vec<String>)> {
+    let captures_of = |matched: &[(&btc_pddl::ast::Action, Vec<(String, String)>)]| -> Vec<(String, Vec<String>)> {
         r.pattern
             .name
             .iter()
@@ -930,10 +929,10 @@ fn literals(
             .args
             .iter()
             .map(|t| match t {
-                crate::pddl::ast::Term::Var { name } => {
+                btc_pddl::ast::Term::Var { name } => {
                     position(&name.name).map_or(format!("?{}", name.name), |i| format!("#{i}"))
                 }
-                crate::pddl::ast::Term::Const { name } => name.name.clone(),
+                btc_pddl::ast::Term::Const { name } => name.name.clone(),
             })
             .collect();
         out.insert((positive, atom.pred.name.clone(), args));
@@ -943,11 +942,7 @@ fn literals(
 
 /// A warning when a rule's effect is not the PDDL action's effect, with the
 /// PDDL effect written in the rule's variables as the hint (the quick fix).
-fn compare_effect(
-    r: &Rule,
-    action: &crate::pddl::ast::Action,
-    effect: &Effect,
-) -> Option<Diagnostic> {
+fn compare_effect(r: &Rule, action: &btc_pddl::ast::Action, effect: &Effect) -> Option<Diagnostic> {
     let rule_pos = |v: &str| r.pattern.params.iter().position(|p| p.var.text == v);
     let action_pos = |v: &str| action.params.iter().position(|p| p.name.name == v);
     let pddl: Vec<&Effect> = action.eff_start.iter().chain(&action.eff_end).collect();
@@ -1008,7 +1003,7 @@ fn show_literal((positive, pred, args): &(bool, String, Vec<String>), r: &Rule) 
 }
 
 /// The PDDL action's effect with its parameters renamed to the rule's variables.
-pub fn rewrite_effect(effects: &[&Effect], action: &crate::pddl::ast::Action, r: &Rule) -> String {
+pub fn rewrite_effect(effects: &[&Effect], action: &btc_pddl::ast::Action, r: &Rule) -> String {
     let text = match effects {
         [one] => one.to_string(),
         many => format!(

@@ -6,8 +6,8 @@
 use super::ast::*;
 use super::lexer::Comment;
 use super::parse::parse_rules;
-use crate::diagnostic::Diagnostic;
-use crate::ir::format_float;
+use btc_ir::format_float;
+use btc_pddl::diagnostic::Diagnostic;
 
 const INDENT: &str = "    ";
 /// Rules whose body is one node call stay on one line up to this width.
@@ -103,7 +103,7 @@ impl Formatter<'_> {
 
     /// Whether the source wrote this span on one line: simple bodies keep
     /// the author's choice between one line and several.
-    fn was_one_line(&self, span: crate::source::Span) -> bool {
+    fn was_one_line(&self, span: btc_pddl::source::Span) -> bool {
         !self.text[self.abs(span.start)..self.abs(span.end).min(self.text.len())].contains('\n')
     }
 

@@ -1,8 +1,8 @@
 //! Tokens of `.btrules` files. Comments are kept apart (the formatter puts
 //! them back); everything else goes to the parser.
 
-use crate::diagnostic::{codes, Diagnostic};
-use crate::source::{FileId, Span};
+use btc_pddl::diagnostic::{codes, Diagnostic};
+use btc_pddl::source::{FileId, Span};
 use std::fmt;
 
 #[derive(Clone, Debug, PartialEq)]
@@ -20,9 +20,9 @@ pub enum Tok {
     Error(char),
     /// A parenthesised PDDL formula, already read by the PDDL front end.
     /// Made by the parser's pre-pass, never by the lexer.
-    Formula(Box<crate::pddl::ast::Formula>),
+    Formula(Box<btc_pddl::ast::Formula>),
     /// A parenthesised PDDL effect (as `Formula`).
-    Effect(Box<crate::pddl::ast::Effect>),
+    Effect(Box<btc_pddl::ast::Effect>),
     /// A parenthesised group that did not read as PDDL (reported).
     BadPddl,
 }

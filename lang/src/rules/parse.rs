@@ -5,11 +5,11 @@
 
 use super::ast::*;
 use super::lexer::{lex, Comment, Tok};
-use crate::diagnostic::{codes, Diagnostic};
-use crate::pddl::lexer::{Tok as PTok, Token as PToken};
-use crate::pddl::parse::{effect_of, formula_of};
-use crate::pddl::sexpr;
-use crate::source::{FileId, Span};
+use btc_pddl::diagnostic::{codes, Diagnostic};
+use btc_pddl::lexer::{Tok as PTok, Token as PToken};
+use btc_pddl::parse::{effect_of, formula_of};
+use btc_pddl::sexpr;
+use btc_pddl::source::{FileId, Span};
 use chumsky::input::ValueInput;
 use chumsky::prelude::*;
 

@@ -4,11 +4,11 @@
 
 #![allow(dead_code)]
 
-use btc_lang::diagnostic::Diagnostic;
-use btc_lang::pipeline::{domain_unit, plan_unit, problem_unit, validate_units};
-use btc_lang::pipeline::{DomainUnit, ProblemUnit};
-use btc_lang::render::to_short;
-use btc_lang::source::Sources;
+use btc_pddl::diagnostic::Diagnostic;
+use btc_pddl::pipeline::{domain_unit, plan_unit, problem_unit, validate_units};
+use btc_pddl::pipeline::{DomainUnit, ProblemUnit};
+use btc_pddl::render::to_short;
+use btc_pddl::source::Sources;
 use btc_planner::{Options, Outcome, Report};
 use std::path::{Path, PathBuf};
 
@@ -43,7 +43,7 @@ pub struct Loaded {
 pub fn load(domain: &Path, problem: &Path) -> Loaded {
     let mut sources = Sources::new();
     let read = |p: &Path| {
-        let (text, _) = btc_lang::source::decode(&std::fs::read(p).unwrap());
+        let (text, _) = btc_pddl::source::decode(&std::fs::read(p).unwrap());
         text
     };
     let d = sources.add(domain.display().to_string(), read(domain));

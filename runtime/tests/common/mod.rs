@@ -2,9 +2,10 @@
 //! does, and build engines over its world.
 #![allow(dead_code)]
 
+use btc_ir::TreeIr;
+use btc_lang::db::JobWorld;
 use btc_lang::db::{self, CompileJob, Database};
-use btc_lang::ir::TreeIr;
-use btc_runtime::{Engine, JobWorld, Options, TreeDoc};
+use btc_runtime::{Engine, Options, TreeDoc};
 use std::path::{Path, PathBuf};
 
 pub fn root() -> PathBuf {
@@ -64,7 +65,12 @@ impl Example {
 
     /// An engine over the example's world for `doc`.
     pub fn engine<'a>(&'a self, w: &'a JobWorld<'a>, doc: &TreeDoc, opts: Options) -> Engine<'a> {
-        Engine::build(doc, Some(w.kb()), opts).unwrap_or_else(|e| panic!("{e}"))
+        Engine::build(
+            doc,
+            Some(btc_runtime::Kb::new(w.domain, w.dix, w.problem, w.pix)),
+            opts,
+        )
+        .unwrap_or_else(|e| panic!("{e}"))
     }
 }
 

@@ -4,8 +4,8 @@
 //! that issues any; a
 //! `repeat(n)` repeats its child's commands n times.
 
-use crate::ir::*;
-use crate::rules::ast::{ControlKind, DecoratorKind};
+use btc_ir::*;
+use btc_ir::{ControlKind, DecoratorKind};
 use serde_json::{json, Map, Value};
 
 const KB_NODES: &[&str] = &["KbHolds", "KbApply", "WaitForStep"];

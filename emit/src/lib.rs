@@ -7,7 +7,7 @@ pub mod commands;
 pub mod dot;
 pub mod pytrees;
 
-use crate::ir::TreeIr;
+use btc_ir::TreeIr;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Format {

@@ -219,7 +219,7 @@ pub fn build(tokens: Vec<Token>) -> (Vec<Sexp>, Vec<Diagnostic>) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::pddl::lexer::lex;
+    use crate::lexer::lex;
 
     fn parse(s: &str) -> (Vec<Sexp>, Vec<Diagnostic>) {
         build(lex(s, 0).0)

@@ -5,8 +5,10 @@
 //! `<SubTree>` with port remapping); [`TreeIr::inlined`] expands every call
 //! for formats and engines that want one flat tree.
 
-use crate::rules::ast::{ControlKind, DecoratorKind};
 use serde::{Deserialize, Serialize};
+
+mod nodes;
+pub use nodes::{ControlKind, DecoratorKind};
 
 pub const IR_VERSION: u32 = 1;
 

@@ -1,11 +1,11 @@
-//! The closed loop as a library (`btc_runtime::run_loop`): the CLI tests
+//! The closed loop as a library (`btc_agent::run_loop`): the CLI tests
 //! (`tests/replan.rs` in the root package) cover every ARIAC scenario; these
 //! check the loop's state handling directly.
 
-mod common;
+use btc_agent::{run_loop, LoopOptions};
 use btc_lang::db::{self, CompileJob, Database};
-use btc_runtime::{run_loop, LoopOptions, Scenario, Status};
-use common::root;
+use btc_runtime::{Scenario, Status};
+use btc_testkit::repo as root;
 
 /// The ARIAC rules and `problem` in a database, with an empty plan file
 /// that the loop fills in.
@@ -78,5 +78,5 @@ fn a_scenario_that_does_not_fit_the_problem_is_an_error() {
     )
     .unwrap();
     let r = run_loop(&mut db, job, false, Some(&sc), &LoopOptions::default());
-    assert!(matches!(r, Err(btc_runtime::LoopError::Scenario(_))));
+    assert!(matches!(r, Err(btc_agent::LoopError::Scenario(_))));
 }

@@ -6,8 +6,8 @@
 //! line's shape decides its format, and reading must run at millions of steps
 //! per second.
 
+use crate::ast::Name;
 use crate::diagnostic::{codes, Diagnostic};
-use crate::pddl::ast::Name;
 use crate::source::{FileId, Span};
 use serde::Serialize;
 

@@ -3,11 +3,11 @@
 //! in [`Sources`]; the CLI, the tests and the incremental database call these.
 
 use crate::diagnostic::{has_errors, Diagnostic};
-use crate::pddl::{self, ast::Domain, ast::Problem, DomainIndex, ProblemIndex};
 use crate::plan::{self, GroundStep, Plan};
 use crate::source::{FileId, Sources};
 use crate::state::World;
 use crate::validate::{validate, Validation};
+use crate::{ast::Domain, ast::Problem, DomainIndex, ProblemIndex};
 
 pub struct DomainUnit {
     pub file: FileId,
@@ -35,10 +35,10 @@ pub fn domain_unit(sources: &Sources, file: FileId) -> DomainUnit {
 }
 
 pub fn domain_unit_from(text: &str, file: FileId) -> DomainUnit {
-    let (domain, mut diagnostics) = pddl::parse_domain(text, file);
+    let (domain, mut diagnostics) = crate::parse_domain(text, file);
     let index = match &domain {
         Some(d) => {
-            let (index, diags) = pddl::check_domain(d);
+            let (index, diags) = crate::check_domain(d);
             diagnostics.extend(diags);
             index
         }
@@ -67,10 +67,10 @@ pub fn problem_unit_from(
     domain: Option<&Domain>,
     dix: &DomainIndex,
 ) -> ProblemUnit {
-    let (problem, mut diagnostics) = pddl::parse_problem(text, file);
+    let (problem, mut diagnostics) = crate::parse_problem(text, file);
     let index = match (&problem, domain) {
         (Some(p), Some(d)) => {
-            let (index, diags) = pddl::check_problem(p, d, dix);
+            let (index, diags) = crate::check_problem(p, d, dix);
             diagnostics.extend(diags);
             index
         }

@@ -4,10 +4,10 @@
 //! - the whole IPC corpus: parse + check every domain and problem
 //!   (target: under 50 ms), and validate every plan.
 
-use btc_lang::pddl::{check_domain, check_problem, parse_domain, parse_problem};
-use btc_lang::pipeline::{domain_unit, plan_unit, problem_unit, validate_units};
-use btc_lang::plan::{parse_plan, type_plan};
-use btc_lang::source::Sources;
+use btc_pddl::pipeline::{domain_unit, plan_unit, problem_unit, validate_units};
+use btc_pddl::plan::{parse_plan, type_plan};
+use btc_pddl::source::Sources;
+use btc_pddl::{check_domain, check_problem, parse_domain, parse_problem};
 use divan::counter::ItemsCount;
 use divan::Bencher;
 use std::path::{Path, PathBuf};
@@ -16,8 +16,6 @@ use std::sync::OnceLock;
 // The same allocator as the `btc` binary.
 #[global_allocator]
 static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
-
-mod common;
 
 fn main() {
     divan::main();
@@ -29,7 +27,7 @@ const STEPS: usize = 100_000;
 
 fn long_plan() -> &'static str {
     static PLAN: OnceLock<String> = OnceLock::new();
-    PLAN.get_or_init(|| common::long_ariac_plan(STEPS))
+    PLAN.get_or_init(|| btc_testkit::long_ariac_plan(STEPS))
 }
 
 #[divan::bench(sample_count = 20)]

@@ -6,8 +6,9 @@
 //! - `warm`: the same database reused (only the plan text changes, as in a
 //!   long-running agent), so salsa re-does only what the plan changes.
 
+use btc_agent::{run_loop, LoopOptions};
 use btc_lang::db::{self, CompileJob, Database};
-use btc_runtime::{run_loop, LoopOptions, Scenario};
+use btc_runtime::Scenario;
 use divan::Bencher;
 use std::path::PathBuf;
 
@@ -29,7 +30,7 @@ fn report() {
             .map(|_| {
                 db.set_file("(planned).sas_plan", String::new());
                 let s = run_loop(&mut db, job, false, Some(&sc), &opts).unwrap();
-                let sum = |f: fn(&btc_runtime::replan::Attempt) -> f64| -> f64 {
+                let sum = |f: fn(&btc_agent::replan::Attempt) -> f64| -> f64 {
                     s.attempts.iter().map(f).sum()
                 };
                 [

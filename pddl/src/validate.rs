@@ -1,8 +1,8 @@
 //! Plan validation: replays a typed plan from the initial state and reports
 //! the first step whose precondition fails, or the goal literals it misses.
 
+use crate::ast::{Action, Domain, Effect, Formula, Problem};
 use crate::diagnostic::{codes, Diagnostic};
-use crate::pddl::ast::{Action, Domain, Effect, Formula, Problem};
 use crate::plan::{GroundStep, Plan};
 use crate::state::{Changes, Env, State, World};
 use serde::Serialize;
@@ -239,8 +239,8 @@ pub fn show_step(world: &World, action: &Action, g: &GroundStep) -> String {
 pub fn validate_plan(
     domain: &Domain,
     problem: &Problem,
-    dix: &crate::pddl::DomainIndex,
-    pix: &crate::pddl::ProblemIndex,
+    dix: &crate::DomainIndex,
+    pix: &crate::ProblemIndex,
     plan: &Plan,
     steps: &[GroundStep],
 ) -> Validation {

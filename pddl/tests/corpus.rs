@@ -2,12 +2,12 @@
 //! list): every domain and problem checks with zero errors and every plan
 //! validates; mutated plans are caught at the right step.
 
-use btc_lang::diagnostic::{has_errors, Diagnostic};
-use btc_lang::pipeline::{
+use btc_pddl::diagnostic::{has_errors, Diagnostic};
+use btc_pddl::pipeline::{
     domain_unit, plan_unit, problem_unit, validate_units, DomainUnit, ProblemUnit,
 };
-use btc_lang::render::to_short;
-use btc_lang::source::Sources;
+use btc_pddl::render::to_short;
+use btc_pddl::source::Sources;
 use std::path::{Path, PathBuf};
 
 /// One problem with its domain and plans.
@@ -74,7 +74,7 @@ fn cases() -> Option<Vec<Case>> {
 
 fn load(sources: &mut Sources, path: &Path) -> u32 {
     let bytes = std::fs::read(path).unwrap();
-    let (text, problem) = btc_lang::source::decode(&bytes);
+    let (text, problem) = btc_pddl::source::decode(&bytes);
     assert!(problem.is_none(), "{}: {problem:?}", path.display());
     sources.add(path.display().to_string(), text)
 }

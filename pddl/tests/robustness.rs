@@ -2,10 +2,10 @@
 //! requirements, bytes that are not UTF-8, huge files and deep nesting all
 //! come back as diagnostics.
 
-use btc_lang::diagnostic::{has_errors, Diagnostic};
-use btc_lang::pipeline::{domain_unit, plan_unit, problem_unit, validate_units};
-use btc_lang::render::to_terminal;
-use btc_lang::source::{decode, Sources};
+use btc_pddl::diagnostic::{has_errors, Diagnostic};
+use btc_pddl::pipeline::{domain_unit, plan_unit, problem_unit, validate_units};
+use btc_pddl::render::to_terminal;
+use btc_pddl::source::{decode, Sources};
 use std::path::PathBuf;
 
 /// The corpus's PDDL files; `None` (the test skipped) without the corpus.

@@ -3,9 +3,9 @@
 //! NIST executor does with the problem's `:objects`.
 
 use super::parse::{Plan, PlanStep};
+use crate::ast::Domain;
+use crate::check::{DomainIndex, ProblemIndex};
 use crate::diagnostic::{codes, did_you_mean, Diagnostic};
-use crate::pddl::ast::Domain;
-use crate::pddl::check::{DomainIndex, ProblemIndex};
 use serde::Serialize;
 
 /// A plan step with its action and arguments resolved to ids.

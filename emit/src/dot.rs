@@ -2,8 +2,8 @@
 //! and Mermaid. Shapes follow the usual BT notation: `→` sequence, `?`
 //! fallback, `⇒` parallel; actions are boxes, conditions ovals.
 
-use crate::ir::*;
-use crate::rules::ast::{ControlKind, DecoratorKind};
+use btc_ir::*;
+use btc_ir::{ControlKind, DecoratorKind};
 
 fn control_label(c: ControlKind) -> String {
     match c {

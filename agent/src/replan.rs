@@ -11,16 +11,16 @@
 //! loop. Nothing here prints or reads files; the CLI loads the files into
 //! the database and renders the result.
 
-use crate::engine::{Engine, FaultRecord, Options, Status};
-use crate::error::LoadError;
-use crate::faults::{FaultOutcome, FaultRt, Scenario};
-use crate::{JobWorld, Kb, TreeDoc};
-use btc_lang::db::{self, CompileJob, Database};
-use btc_lang::diagnostic::{codes, Diagnostic};
-use btc_lang::pddl::ast::Formula;
-use btc_lang::source::Span;
-use btc_lang::state::State;
+use btc_lang::db::{self, CompileJob, Database, JobWorld};
+use btc_pddl::ast::Formula;
+use btc_pddl::diagnostic::{codes, Diagnostic};
+use btc_pddl::source::Span;
+use btc_pddl::state::State;
 use btc_planner::Outcome;
+use btc_runtime::engine::{Engine, FaultRecord, Options, Status};
+use btc_runtime::error::LoadError;
+use btc_runtime::faults::{FaultOutcome, FaultRt, Scenario};
+use btc_runtime::{Kb, TreeDoc};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -393,7 +393,8 @@ pub fn run_loop(
             .faults
             .iter()
             .filter(|f| {
-                f.kind == crate::faults::FaultKind::HighPriorityOrder && f.met_at == Some(end_tick)
+                f.kind == btc_runtime::faults::FaultKind::HighPriorityOrder
+                    && f.met_at == Some(end_tick)
             })
             .map(|f| f.fault.clone())
             .collect();
@@ -592,7 +593,7 @@ fn world(db: &Database, job: CompileJob) -> Result<JobWorld<'_>, LoopError> {
 
 /// The KB of the problem, in the carried state.
 fn kb_at<'w>(w: &JobWorld<'w>, carry: &Carry) -> Kb<'w> {
-    let mut kb = w.kb();
+    let mut kb = Kb::new(w.domain, w.dix, w.problem, w.pix);
     if let Some(s) = &carry.state {
         kb.state = s.clone();
     }
@@ -711,7 +712,8 @@ fn unreachable(
             .collect(),
         _ => vec![goal_text.to_owned()],
     };
-    let shown = |lit: &str| crate::faults::naming(carry.faults.as_deref().unwrap_or(&[]), lit);
+    let shown =
+        |lit: &str| btc_runtime::faults::naming(carry.faults.as_deref().unwrap_or(&[]), lit);
     let mut out = Vec::new();
     for lit in parts {
         // A nested `(and ...)` (added goals) is split too.

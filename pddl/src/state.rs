@@ -2,10 +2,10 @@
 //! validator replays plans with this; the runtime's simulated world uses the
 //! same code as its knowledge base.
 
-use crate::pddl::ast::*;
-use crate::pddl::check::{DomainIndex, ProblemIndex};
-use crate::pddl::types::TypeId;
+use crate::ast::*;
+use crate::check::{DomainIndex, ProblemIndex};
 use crate::source::Span;
+use crate::types::TypeId;
 use rustc_hash::{FxHashMap, FxHashSet};
 use std::cell::RefCell;
 

@@ -14,8 +14,8 @@
 //! made unique ([`py_ident`], [`Names`]); comments only ever contain escaped
 //! text. The output is ASCII and deterministic.
 
-use crate::ir::{format_float, LeafKind, Node, NodeModel, Port, PortValue, StepInfo, TreeIr};
-use crate::rules::ast::{ControlKind, DecoratorKind};
+use btc_ir::{format_float, LeafKind, Node, NodeModel, Port, PortValue, StepInfo, TreeIr};
+use btc_ir::{ControlKind, DecoratorKind};
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write;
 

@@ -6,8 +6,8 @@
 //!
 //! `SubTree` elements get no `name` attribute: Groot2's monitor crashes on it.
 
-use crate::ir::*;
-use crate::rules::ast::{ControlKind, DecoratorKind};
+use btc_ir::*;
+use btc_ir::{ControlKind, DecoratorKind};
 use std::fmt::Write as _;
 
 /// Whether a character must be escaped (or replaced) in an attribute value.

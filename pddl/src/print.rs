@@ -120,7 +120,7 @@ pub fn effects(parts: &[Effect]) -> String {
 
 #[cfg(test)]
 mod tests {
-    use crate::pddl::parse::parse_domain;
+    use crate::parse::parse_domain;
 
     #[test]
     fn prints_what_it_parsed() {

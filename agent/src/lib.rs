@@ -1,0 +1,10 @@
+//! The closed loop on top of the runtime, the planner and the rules
+//! language: an agent that plans, compiles the plan into a tree, runs it in
+//! the simulated world and replans from what a fault left ([`replan`]).
+//!
+//! This is the only crate that puts the three together; the runtime knows
+//! nothing of planning or of the rules database.
+
+pub mod replan;
+
+pub use replan::{run_loop, LoopError, LoopOptions, LoopSummary};
