@@ -92,12 +92,21 @@ pub fn check(path: &Path, format: Format) -> anyhow::Result<ExitCode> {
     })
 }
 
+/// What `btc compile` writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Output {
+    /// The compiled tree in a format.
+    Tree(emit::Format),
+    /// The problem's world as a `.kb` file (for the C++ knowledge base).
+    Kb,
+}
+
 pub struct CompileArgs {
     pub rules: PathBuf,
     pub plan: PathBuf,
     pub problem: Option<PathBuf>,
     pub domain: Option<PathBuf>,
-    pub emit: emit::Format,
+    pub emit: Output,
     pub output: Option<PathBuf>,
     pub options: emit::Options,
     pub format: Format,
@@ -209,7 +218,15 @@ pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
         }
         return Ok(ExitCode::from(1));
     };
-    let text = emit::emit(ir, a.emit, &a.options);
+    let text = match a.emit {
+        Output::Tree(f) => emit::emit(ir, f, &a.options),
+        Output::Kb => match db::JobWorld::of(&database, job) {
+            Some(w) => emit::kb::emit(w.domain, w.dix, w.problem, w.pix),
+            None => anyhow::bail!(
+                "`--emit kb` needs the PDDL problem: pass `--problem PROBLEM` or name it in the rules file"
+            ),
+        },
+    };
     match &a.output {
         Some(out) => {
             files::write_atomically(out, &text)?;

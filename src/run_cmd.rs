@@ -268,6 +268,9 @@ fn execute(
             if let (Some(o), Some(c)) = (v.as_object_mut(), &commands) {
                 o.insert("commands".into(), serde_json::to_value(c)?);
             }
+            if let (Some(o), Some(kb)) = (v.as_object_mut(), &engine.kb) {
+                o.insert("kb".into(), serde_json::to_value(kb.snapshot())?);
+            }
             println!("{}", serde_json::to_string_pretty(&v)?);
         }
         Format::Text => print_summary(&summary, commands.as_ref().map(Vec::len)),

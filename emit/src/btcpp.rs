@@ -265,9 +265,22 @@ fn node(x: &mut Xml, n: &Node, ir: &TreeIr) {
             number(x, "step", step + 1);
             let start = info.and_then(|s| s.eff_start.as_deref()).unwrap_or("");
             let end = info.and_then(|s| s.eff_end.as_deref()).unwrap_or("");
-            x.attr("start_effect", start)
-                .attr("end_effect", end)
-                .close(false);
+            x.attr("start_effect", start).attr("end_effect", end);
+            // The step's conditions, so an executor that does not read the
+            // domain checks what `btc run` checks (written only when there
+            // are some: most steps have just a precondition).
+            if let Some(s) = info {
+                for (key, cond) in [
+                    ("start_condition", &s.pre_start),
+                    ("over_all_condition", &s.pre_over_all),
+                    ("end_condition", &s.pre_end),
+                ] {
+                    if let Some(c) = cond.as_deref().filter(|c| !c.trim().is_empty()) {
+                        x.attr(key, c);
+                    }
+                }
+            }
+            x.close(false);
             node(x, child, ir);
             x.end("KbStep");
         }
@@ -344,13 +357,16 @@ pub fn emit(ir: &TreeIr, inline: bool) -> String {
             .attr("ID", "KbStep")
             .attr(
                 "description",
-                "a plan step: applies its PDDL effects to the KB when it starts and when its child succeeds",
+                "a plan step: applies its PDDL effects to the KB when it starts and when its child succeeds; its conditions are checked when it starts (before at-start effects), while it runs and when its child succeeds",
             )
             .close(false);
         for (name, ty) in [
             ("step", "int"),
             ("start_effect", "std::string"),
             ("end_effect", "std::string"),
+            ("start_condition", "std::string"),
+            ("over_all_condition", "std::string"),
+            ("end_condition", "std::string"),
         ] {
             x.open("input_port")
                 .attr("name", name)

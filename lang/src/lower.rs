@@ -1073,29 +1073,34 @@ fn node_models(decls: &Decls, used: &BTreeSet<String>) -> Vec<NodeModel> {
     used.iter()
         .filter_map(|id| {
             let n = decls.nodes.get(id).cloned().or_else(|| kb_decl(id))?;
-            Some(NodeModel {
-                id: id.clone(),
-                kind: match n.kind {
-                    NodeKind::Action => LeafKind::Action,
-                    NodeKind::Condition => LeafKind::Condition,
-                },
-                ports: n
-                    .ports
-                    .iter()
-                    .map(|p| PortModel {
-                        name: p.name.text.clone(),
-                        direction: if p.out {
-                            PortDirection::Output
-                        } else {
-                            PortDirection::Input
-                        },
-                        ty: p.ty.text.clone(),
-                    })
-                    .collect(),
-                formula: n.formula.as_ref().map(|f| f.to_string()),
-            })
+            Some(node_model(id, &n))
         })
         .collect()
+}
+
+/// The IR's model of a declared node: its kind, ports and formula.
+pub fn node_model(id: &str, n: &NodeDecl) -> NodeModel {
+    NodeModel {
+        id: id.to_owned(),
+        kind: match n.kind {
+            NodeKind::Action => LeafKind::Action,
+            NodeKind::Condition => LeafKind::Condition,
+        },
+        ports: n
+            .ports
+            .iter()
+            .map(|p| PortModel {
+                name: p.name.text.clone(),
+                direction: if p.out {
+                    PortDirection::Output
+                } else {
+                    PortDirection::Input
+                },
+                ty: p.ty.text.clone(),
+            })
+            .collect(),
+        formula: n.formula.as_ref().map(|f| f.to_string()),
+    }
 }
 
 /// The `std::kb` declarations btc itself emits, available without import.

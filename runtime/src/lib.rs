@@ -12,6 +12,7 @@ pub mod controller;
 pub mod engine;
 pub mod error;
 pub mod faults;
+pub mod handler;
 pub mod kb;
 pub mod spec;
 pub mod xml;
@@ -20,6 +21,7 @@ pub use controller::{Command, Controller};
 pub use engine::{Engine, FaultRecord, Options, Status, Value};
 pub use error::LoadError;
 pub use faults::{FaultKind, FaultOutcome, Scenario};
+pub use handler::{ActionCall, ActionHandler};
 pub use kb::Kb;
 pub use spec::TreeDoc;
 

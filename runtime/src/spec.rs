@@ -38,6 +38,10 @@ pub enum Kind {
         step: usize,
         start_effect: Option<String>,
         end_effect: Option<String>,
+        /// The step's conditions as the XML gives them (`start_condition`,
+        /// `over_all_condition`, `end_condition`); `None` when it gives none
+        /// (they are then the domain action's, grounded from the name).
+        conditions: Option<StepConditions>,
     },
     /// A leaf: built in, a KB node, or a node of the models.
     Leaf {
@@ -45,6 +49,14 @@ pub enum Kind {
         kind: Option<LeafKind>,
         ports: Vec<(String, PortValue)>,
     },
+}
+
+/// A step's ground conditions, by when they are checked.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct StepConditions {
+    pub start: Option<String>,
+    pub over_all: Option<String>,
+    pub end: Option<String>,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -185,6 +197,7 @@ pub fn from_node(n: &Node) -> SNode {
                 step: *step,
                 start_effect: None,
                 end_effect: None,
+                conditions: None,
             },
             None,
             vec![from_node(child)],

@@ -5,7 +5,7 @@
 
 use crate::engine::MAX_DEPTH;
 use crate::error::LoadError;
-use crate::spec::{Kind, SNode, TreeDoc};
+use crate::spec::{Kind, SNode, StepConditions, TreeDoc};
 use btc_ir::{LeafKind, NodeModel, PortDirection, PortModel, PortValue};
 use btc_pddl::diagnostic::codes;
 use quick_xml::events::{BytesStart, Event};
@@ -94,6 +94,17 @@ fn ports(e: &mut Elem, skip: &[&str]) -> Vec<(String, PortValue)> {
         .collect()
 }
 
+/// A `KbStep`'s condition attributes, when it has any.
+fn step_conditions(e: &Elem) -> Option<StepConditions> {
+    let get = |k: &str| e.get(k).map(str::to_owned);
+    let c = StepConditions {
+        start: get("start_condition"),
+        over_all: get("over_all_condition"),
+        end: get("end_condition"),
+    };
+    (c != StepConditions::default()).then_some(c)
+}
+
 fn node_of(mut e: Elem) -> Result<SNode, LoadError> {
     let name = e.get("name").map(str::to_owned);
     let kind = match e.name.as_str() {
@@ -146,6 +157,7 @@ fn node_of(mut e: Elem) -> Result<SNode, LoadError> {
                 step: step - 1,
                 start_effect: e.get("start_effect").map(str::to_owned),
                 end_effect: e.get("end_effect").map(str::to_owned),
+                conditions: step_conditions(&e),
             }
         }
         // Groot 1 spelling: <Action ID="MoveTo" .../>.
