@@ -199,7 +199,7 @@ fn from_btc_run(summary: &str, trace: &str) -> Outcome {
         goal: s["goal_reached"].as_bool().unwrap_or(true),
         kb: s["kb"]
             .as_array()
-            .unwrap()
+            .unwrap_or_else(|| panic!("btc run printed no KB:\n{summary}"))
             .iter()
             .map(|f| f.as_str().unwrap().to_owned())
             .collect(),
