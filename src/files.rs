@@ -70,6 +70,11 @@ fn decode_diagnostic(id: FileId, problem: DecodeProblem) -> Diagnostic {
 /// Writes `text` to `path` through a temporary file in the same folder and
 /// a rename, so a failed run never leaves a half-written output.
 pub fn write_atomically(path: &Path, text: &str) -> anyhow::Result<()> {
+    write_bytes_atomically(path, text.as_bytes())
+}
+
+/// [`write_atomically`] for bytes.
+pub fn write_bytes_atomically(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
     use std::io::Write;
     let dir = path
         .parent()
@@ -77,7 +82,7 @@ pub fn write_atomically(path: &Path, text: &str) -> anyhow::Result<()> {
         .unwrap_or(Path::new("."));
     let mut tmp = tempfile::NamedTempFile::new_in(dir)
         .map_err(|e| anyhow::anyhow!("cannot write in `{}`: {e}", dir.display()))?;
-    tmp.write_all(text.as_bytes())?;
+    tmp.write_all(bytes)?;
     tmp.as_file().sync_all()?;
     tmp.persist(path)
         .map_err(|e| anyhow::anyhow!("cannot write `{}`: {}", path.display(), e.error))?;

@@ -54,12 +54,14 @@ pub struct File {
 pub const USER_NODES: &str = "nodes.hpp";
 
 /// Node IDs BehaviorTree.CPP 4.10 registers itself (its factory's
-/// `builtinNodes()`): a rules file may not declare them again.
+/// `builtinNodes()`, as `runtime/src/btcpp_builtins.xml` has them from
+/// BT.CPP): a rules file may not declare them again.
 pub const BTCPP_BUILTINS: &[&str] = &[
     "AlwaysFailure",
     "AlwaysSuccess",
+    "AsyncFallback",
+    "AsyncSequence",
     "Delay",
-    "EntryUpdated",
     "Fallback",
     "ForceFailure",
     "ForceSuccess",
@@ -952,6 +954,17 @@ mod tests {
             accessors(&m),
             ["robot", "class_port", "name_port", "name_port_port"]
         );
+    }
+
+    #[test]
+    fn the_builtin_list_is_btcpp_4_10s() {
+        let models = include_str!("../../runtime/src/btcpp_builtins.xml");
+        let ids: Vec<&str> = models
+            .split("ID=\"")
+            .skip(1)
+            .map(|r| &r[..r.find('"').unwrap()])
+            .collect();
+        assert_eq!(ids, BTCPP_BUILTINS);
     }
 
     #[test]

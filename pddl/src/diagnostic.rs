@@ -252,6 +252,7 @@ pub mod codes {
         X_TOO_DEEP = "X007", "a tree nested deeper than the runtime runs";
         X_REPLAN_UNSOLVABLE = "X008", "a goal that replanning cannot reach after a fault";
         X_REPLAN_LIMIT = "X009", "a closed loop that stopped at its replan or tick limit";
+        X_BTLOG = "X030", "a run that a Groot2 `.btlog` file cannot hold";
         // The C++ executor for BehaviorTree.CPP (`btc executor`)
         C_CLASS_NAME = "C001", "a node whose name cannot become a C++ class of the executor";
         C_REGISTERED = "C002", "a node that BehaviorTree.CPP or btc's support library registers already";

@@ -8,6 +8,7 @@
 //! [`Engine::build`] compiles it into a flat arena and [`Engine::run`]
 //! ticks it.
 
+pub mod btlog;
 pub mod controller;
 pub mod engine;
 pub mod error;

@@ -51,6 +51,11 @@ struct Case {
 // ---------------------------------------------------------------- btc
 
 fn run_btc(case: &Case) -> Result<Run, String> {
+    run_btc_logged(case).map(|(r, _)| r)
+}
+
+/// [`run_btc`], with the run's `.btlog` as btc writes it.
+fn run_btc_logged(case: &Case) -> Result<(Run, Vec<u8>), String> {
     let doc = xml::parse(&case.xml).map_err(|e| e.to_string())?;
     let opts = Options {
         trace: true,
@@ -83,6 +88,7 @@ fn run_btc(case: &Case) -> Result<Run, String> {
         reset: None,
     };
     let mut seen = 0;
+    let mut last = Status::Running;
     for _ in 0..case.ticks {
         let s = e.tick_once();
         let mut changes = Vec::new();
@@ -94,11 +100,14 @@ fn run_btc(case: &Case) -> Result<Run, String> {
         seen = e.trace.len();
         run.ticks.push(changes);
         run.status = letter(s);
+        last = s;
         if s != Status::Running {
             break;
         }
     }
-    Ok(run)
+    let log = btc_runtime::btlog::write(&doc, &e, last, case.tick_ms.max(1), 0)
+        .map_err(|e| e.to_string())?;
+    Ok((run, log))
 }
 
 // ------------------------------------------------------------- BT.CPP
@@ -108,6 +117,16 @@ fn harness() -> Option<PathBuf> {
 }
 
 fn run_btcpp(exe: &PathBuf, cases: &[Case], name: &str) -> Vec<Result<Run, String>> {
+    run_btcpp_logged(exe, cases, name, None)
+}
+
+/// [`run_btcpp`]; with `btlog`, BT.CPP's FileLogger2 writes `btlog/cI.btlog`.
+fn run_btcpp_logged(
+    exe: &PathBuf,
+    cases: &[Case],
+    name: &str,
+    btlog: Option<&std::path::Path>,
+) -> Vec<Result<Run, String>> {
     let dir = btc_testkit::target_dir("btcpp/conformance");
     std::fs::create_dir_all(&dir).unwrap();
     let input = dir.join(format!("{name}.cases"));
@@ -122,7 +141,12 @@ fn run_btcpp(exe: &PathBuf, cases: &[Case], name: &str) -> Vec<Result<Run, Strin
         );
     }
     std::fs::write(&input, text).unwrap();
-    let out = Command::new(exe).arg(&input).output().unwrap();
+    let mut cmd = Command::new(exe);
+    if let Some(dir) = btlog {
+        std::fs::create_dir_all(dir).unwrap();
+        cmd.arg("--btlog").arg(dir);
+    }
+    let out = cmd.arg(&input).output().unwrap();
     assert!(
         out.status.success(),
         "the harness failed: {}",
@@ -540,4 +564,143 @@ fn the_tree_driver_resets_the_root_after_the_last_tick() {
             assert_eq!(cpp.reset, Some((0, cpp.status, 'I')));
         }
     }
+}
+
+// ------------------------------------------------------------ .btlog
+
+/// An XML element with its attributes as a set (BT.CPP keeps ports in a
+/// hash map, so their order means nothing) and, for port lists, its
+/// children as a set too.
+#[derive(Debug, PartialEq, Eq, PartialOrd, Ord, Clone)]
+struct El {
+    name: String,
+    attrs: std::collections::BTreeMap<String, String>,
+    text: String,
+    children: Vec<El>,
+}
+
+fn parse_xml(text: &str) -> El {
+    use quick_xml::events::Event;
+    let mut r = quick_xml::Reader::from_str(text);
+    r.config_mut().trim_text(true);
+    let decoder = r.decoder();
+    let el = |e: &quick_xml::events::BytesStart| El {
+        name: String::from_utf8_lossy(e.name().as_ref()).into_owned(),
+        attrs: e
+            .attributes()
+            .map(|a| {
+                let a = a.unwrap();
+                (
+                    String::from_utf8_lossy(a.key.as_ref()).into_owned(),
+                    a.decode_and_unescape_value(decoder).unwrap().into_owned(),
+                )
+            })
+            .collect(),
+        text: String::new(),
+        children: Vec::new(),
+    };
+    let mut stack: Vec<El> = vec![El {
+        name: String::new(),
+        attrs: Default::default(),
+        text: String::new(),
+        children: Vec::new(),
+    }];
+    loop {
+        match r.read_event().unwrap() {
+            Event::Start(e) => stack.push(el(&e)),
+            Event::Empty(e) => stack.last_mut().unwrap().children.push(el(&e)),
+            Event::Text(t) => {
+                let d = t.decode().unwrap();
+                stack.last_mut().unwrap().text =
+                    quick_xml::escape::unescape(&d).unwrap().into_owned();
+            }
+            Event::End(_) => {
+                let done = stack.pop().unwrap();
+                stack.last_mut().unwrap().children.push(done);
+            }
+            Event::Eof => break,
+            _ => {}
+        }
+    }
+    let mut doc = stack.pop().unwrap();
+    let mut root = doc.children.remove(0);
+    for c in &mut root.children {
+        if c.name == "TreeNodesModel" {
+            for m in &mut c.children {
+                m.children.sort();
+            }
+        }
+    }
+    root
+}
+
+/// A `.btlog` read back: its XML and its (uid, status) records, with the
+/// timestamps checked to never go back.
+fn read_btlog(b: &[u8]) -> (El, Vec<(u16, u8)>) {
+    assert_eq!(&b[..18], b"BTCPP4-FileLogger2");
+    assert_eq!(b[18], 1, "protocol");
+    let n = i32::from_le_bytes(b[19..23].try_into().unwrap()) as usize;
+    let xml = parse_xml(std::str::from_utf8(&b[23..23 + n]).unwrap());
+    let records = &b[23 + n + 8..];
+    assert_eq!(records.len() % 9, 0);
+    let mut last = 0u64;
+    let mut out = Vec::new();
+    for r in records.chunks(9) {
+        let mut t = [0u8; 8];
+        t[..6].copy_from_slice(&r[..6]);
+        let t = u64::from_le_bytes(t);
+        assert!(t >= last, "timestamps go back");
+        last = t;
+        out.push((u16::from_le_bytes([r[6], r[7]]), r[8]));
+    }
+    (xml, out)
+}
+
+#[test]
+fn btc_run_btlog_has_the_structure_btcpp_filelogger2_writes() {
+    let Some(exe) = harness() else { return };
+    let mut g = Gen {
+        rng: fastrand::Rng::with_seed(0x0062_746c_6f67),
+        subtrees: Vec::new(),
+    };
+    let cases: Vec<Case> = (0..300)
+        .map(|_| Case {
+            xml: g.tree(),
+            ticks: 12,
+            tick_ms: 0,
+        })
+        .collect();
+    let dir = btc_testkit::target_dir("btcpp/conformance/btlog");
+    let _ = std::fs::remove_dir_all(&dir);
+    let cpp = run_btcpp_logged(&exe, &cases, "btlog", Some(&dir));
+    let mut records = 0;
+    for (i, (case, cpp)) in cases.iter().zip(&cpp).enumerate() {
+        assert!(cpp.is_ok(), "case {i}: {cpp:?}");
+        let (_, mine) = run_btc_logged(case).unwrap();
+        let theirs = std::fs::read(dir.join(format!("c{i}.btlog"))).unwrap();
+        let (x_mine, r_mine) = read_btlog(&mine);
+        let (x_theirs, r_theirs) = read_btlog(&theirs);
+        assert_eq!(x_mine, x_theirs, "case {i}: the XML differs\n{}", case.xml);
+        assert_eq!(
+            r_mine, r_theirs,
+            "case {i}: the transitions differ\n{}",
+            case.xml
+        );
+        records += r_mine.len();
+    }
+    assert!(records > 10 * cases.len(), "{records} transitions compared");
+}
+
+#[test]
+fn the_builtin_models_btc_writes_are_btcpp_4_10s() {
+    let Some(exe) = harness() else { return };
+    let out = Command::new(exe).arg("--builtins").output().unwrap();
+    assert!(out.status.success());
+    let theirs = String::from_utf8(out.stdout).unwrap();
+    let mine = include_str!("../src/btcpp_builtins.xml");
+    assert_eq!(
+        parse_xml(mine),
+        parse_xml(&theirs),
+        "runtime/src/btcpp_builtins.xml is not what BT.CPP writes: regenerate it with `btc_conformance --builtins`"
+    );
 }

@@ -22,11 +22,15 @@
 // printed as `reset N FROM TO`, apart from the nodes' own changes.
 //
 // With --btlog DIR, each case also writes DIR/NAME.btlog with FileLogger2.
+// `--builtins` prints the models of BT.CPP's own nodes
+// (BT::writeTreeNodesModelXML of a bare factory) and exits.
 #include <behaviortree_cpp/bt_factory.h>
 #include <behaviortree_cpp/loggers/abstract_logger.h>
 #include <behaviortree_cpp/loggers/bt_file_logger_v2.h>
+#include <behaviortree_cpp/xml_parsing.h>
 
 #include <chrono>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <map>
@@ -147,10 +151,12 @@ void runCase(const std::string& name, long ticks, long tick_ms, const std::strin
                                 index.emplace(n, i);
                               });
     std::unique_ptr<BT::FileLogger2> btlog;
+    const std::string btlog_path = btlog_dir + "/" + name + ".btlog";
     if(!btlog_dir.empty())
     {
-      btlog = std::make_unique<BT::FileLogger2>(tree, btlog_dir + "/" + name + ".btlog");
+      btlog = std::make_unique<BT::FileLogger2>(tree, btlog_path);
     }
+    std::size_t changes_total = 0;
     Recorder rec(tree.rootNode());
     BT::NodeStatus status = BT::NodeStatus::RUNNING;
     for(long t = 1; t <= ticks && status == BT::NodeStatus::RUNNING; ++t)
@@ -163,6 +169,7 @@ void runCase(const std::string& name, long ticks, long tick_ms, const std::strin
       // Changes a timer thread made while the harness slept (a Timeout
       // halting its child) belong to this tick, before the tick's own.
       const std::vector<Change> changes = rec.take();
+      changes_total += changes.size();
       std::cout << "tick " << t << "\n";
       for(std::size_t k = 0; k < changes.size(); ++k)
       {
@@ -174,6 +181,24 @@ void runCase(const std::string& name, long ticks, long tick_ms, const std::strin
       }
     }
     std::cout << "status " << letter(status) << "\n";
+    if(btlog)
+    {
+      // FileLogger2 writes from a thread that stops at once when the logger
+      // is destroyed, dropping what it has not written yet: wait until every
+      // change is in the file (header, XML, timestamp, 9 bytes a change).
+      const std::size_t want = 18 + 1 + 4 + BT::WriteTreeToXML(tree, true, true).size() + 8 +
+                               9 * changes_total;
+      for(int i = 0; i < 500; ++i)
+      {
+        btlog->flush();
+        std::error_code ec;
+        if(std::filesystem::file_size(btlog_path, ec) >= want)
+        {
+          break;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+      }
+    }
   }
   catch(const std::exception& e)
   {
@@ -201,6 +226,12 @@ int main(int argc, char** argv)
     if(a == "--btlog" && i + 1 < argc)
     {
       btlog_dir = argv[++i];
+    }
+    else if(a == "--builtins")
+    {
+      const BT::BehaviorTreeFactory factory;
+      std::cout << BT::writeTreeNodesModelXML(factory, true) << "\n";
+      return 0;
     }
     else
     {
