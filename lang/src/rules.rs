@@ -5,6 +5,7 @@ pub mod check;
 pub mod fmt;
 pub mod lexer;
 pub mod matching;
+pub mod palette;
 pub mod parse;
 
 pub use ast::*;
