@@ -7,4 +7,4 @@
 
 pub mod replan;
 
-pub use replan::{run_loop, LoopError, LoopOptions, LoopSummary};
+pub use replan::{run_loop, run_loop_traced, LoopError, LoopOptions, LoopSummary};
