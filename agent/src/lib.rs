@@ -6,7 +6,9 @@
 //! This is the only crate that puts the three together; the runtime knows
 //! nothing of planning or of the rules database.
 
+pub mod cell;
 pub mod replan;
+pub mod sim;
 pub mod trial;
 
 pub use replan::{run_loop, LoopError, LoopOptions, LoopSummary};
