@@ -7,6 +7,8 @@
 //! nothing of planning or of the rules database.
 
 pub mod cell;
+pub mod matrix;
+pub mod random;
 pub mod replan;
 pub mod sim;
 pub mod trial;

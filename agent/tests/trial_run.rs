@@ -39,3 +39,25 @@ fn the_kitting_trial_scores_full_marks() {
     println!("{}", serde_json::to_string_pretty(&r).unwrap());
     assert_eq!(r.score, r.best, "{r:#?}");
 }
+
+#[test]
+fn the_assembly_trial_scores_full_marks() {
+    let r = run("assembly");
+    assert_eq!(
+        r.score,
+        r.best,
+        "{}",
+        serde_json::to_string_pretty(&r).unwrap()
+    );
+}
+
+#[test]
+fn the_combined_trial_scores_full_marks() {
+    let r = run("combined");
+    assert_eq!(
+        r.score,
+        r.best,
+        "{}",
+        serde_json::to_string_pretty(&r).unwrap()
+    );
+}

@@ -3,6 +3,7 @@
 //! ([`spec`], [`template`]); the trial's PDDL problem built from a trial
 //! and a cell ([`problem`]).
 
+pub mod bundled;
 pub mod load;
 pub mod problem;
 pub mod spec;
