@@ -204,6 +204,9 @@ pub fn table(m: &Matrix) -> String {
     s
 }
 
+/// What a chart panel shows of a cell.
+type Measure = fn(&Cell) -> f64;
+
 /// A grouped bar chart per measure (score, time): one group per task type,
 /// one bar per challenge, the baseline dashed across each group.
 pub fn svg(m: &Matrix) -> String {
@@ -218,7 +221,7 @@ pub fn svg(m: &Matrix) -> String {
         "#999999", "#e41a1c", "#377eb8", "#4daf4a", "#984ea3", "#ff7f00", "#a65628", "#f781bf",
         "#17becf",
     ];
-    let panels: [(&str, fn(&Cell) -> f64); 2] = [
+    let panels: [(&str, Measure); 2] = [
         ("(a) trial score", |c| c.score),
         ("(b) order time (s)", |c| c.time),
     ];

@@ -80,6 +80,7 @@ pub struct Facts {
     pub in_kit: AtomTemplate,
     pub kit_free: AtomTemplate,
     pub installed: AtomTemplate,
+    pub insert_free: AtomTemplate,
     pub fits: AtomTemplate,
     pub discarded: AtomTemplate,
     pub tray_at: AtomTemplate,
@@ -92,7 +93,7 @@ pub struct Facts {
 
 impl Facts {
     /// Each fact with its name and the holes it must have.
-    pub fn each(&self) -> [(&'static str, &AtomTemplate, &'static [Var]); 18] {
+    pub fn each(&self) -> [(&'static str, &AtomTemplate, &'static [Var]); 19] {
         use Var::*;
         [
             ("enabled", &self.enabled, &[Robot]),
@@ -105,6 +106,7 @@ impl Facts {
             ("in_kit", &self.in_kit, &[Part, Agv, Quadrant]),
             ("kit_free", &self.kit_free, &[Agv, Quadrant]),
             ("installed", &self.installed, &[Part, Station]),
+            ("insert_free", &self.insert_free, &[Station, Slot]),
             ("fits", &self.fits, &[Part, Slot]),
             ("discarded", &self.discarded, &[Part]),
             ("tray_at", &self.tray_at, &[Tray, Place]),
@@ -192,7 +194,7 @@ const NAME_KEYS: [(&str, &[&str]); 12] = [
     ("part", &["color", "type", "k"]),
 ];
 
-const FACT_KEYS: [&str; 18] = [
+const FACT_KEYS: [&str; 19] = [
     "enabled",
     "robot_at",
     "hand_empty",
@@ -203,6 +205,7 @@ const FACT_KEYS: [&str; 18] = [
     "in_kit",
     "kit_free",
     "installed",
+    "insert_free",
     "fits",
     "discarded",
     "tray_at",
@@ -459,6 +462,7 @@ impl CellSpec {
             in_kit: take("in_kit")?,
             kit_free: take("kit_free")?,
             installed: take("installed")?,
+            insert_free: take("insert_free")?,
             fits: take("fits")?,
             discarded: take("discarded")?,
             tray_at: take("tray_at")?,

@@ -539,12 +539,18 @@ impl<'w, 'd> Sim<'w, 'd> {
 
     fn signature(&self) -> (usize, usize, usize, usize) {
         (
-            self.tasks.len(),
+            self.tasks.len() + self.tasks.iter().map(|t| t.attempts.len()).sum::<usize>(),
             self.tasks.iter().filter(|t| t.is_open()).count(),
             self.tasks
                 .iter()
                 .filter(|t| t.state == TaskState::Blocked)
-                .count(),
+                .count()
+                + 1000
+                    * self
+                        .tasks
+                        .iter()
+                        .filter(|t| matches!(t.state, TaskState::Running { .. }))
+                        .count(),
             self.orders.iter().filter(|o| o.announced.is_some()).count()
                 + self.orders.iter().filter(|o| o.submitted.is_some()).count(),
         )
@@ -1056,9 +1062,33 @@ impl<'w, 'd> Sim<'w, 'd> {
     /// A part for the task, by the paper's preferences: the one the agent's
     /// robot holds (what the fault record kept), then one on the conveyor,
     /// then one lying the right way up, then any.
-    fn pick_part(&self, a: usize, kind: PartKind, from_agvs: &[u8]) -> Result<Option<usize>, ()> {
+    fn pick_part(
+        &self,
+        a: usize,
+        t: TaskId,
+        kind: PartKind,
+        from_agvs: &[u8],
+    ) -> Result<Option<usize>, ()> {
         let robot = self.agents[a].obj;
         let s = &self.kb.state;
+        // The part the task's last attempt used, wherever it lies now (the
+        // fault record keeps it), unless another robot holds it.
+        if let Some(k) = self.tasks[t].part {
+            let p = &self.parts[k];
+            let usable = match self.facts.place(s, p.obj) {
+                Place::Held(r) => r == robot,
+                Place::At(_) | Place::InKit { .. } => true,
+                _ => false,
+            };
+            if usable
+                && p.gone.is_none()
+                && !p.faulty
+                && p.reserved.is_none()
+                && p.info.kind == kind
+            {
+                return Ok(Some(k));
+            }
+        }
         let mut best: Option<(u8, usize)> = None;
         let mut someone_has = false;
         for (k, p) in self.parts.iter().enumerate() {
@@ -1242,7 +1272,7 @@ impl<'w, 'd> Sim<'w, 'd> {
                         resources.push(Resource::Part(occ));
                     }
                 }
-                match self.pick_part(a, part, &[]) {
+                match self.pick_part(a, t, part, &[]) {
                     Ok(Some(k)) => {
                         resources.push(Resource::Part(k));
                         goal.extend(self.lits_kit(self.parts[k].obj, aobj, qobj));
@@ -1282,7 +1312,7 @@ impl<'w, 'd> Sim<'w, 'd> {
                         Some(k) if self.parts[k].gone.is_none() => k,
                         _ => return Resolve::Never("the part its kitting half placed is gone".into()),
                     },
-                    None => match self.pick_part(a, part, &agvs) {
+                    None => match self.pick_part(a, t, part, &agvs) {
                         Ok(Some(k)) => k,
                         Ok(None) => return Resolve::Wait,
                         Err(()) if agvs.is_empty() => {
@@ -1413,8 +1443,19 @@ impl<'w, 'd> Sim<'w, 'd> {
         t: TaskId,
         part: Option<usize>,
         resources: Vec<Resource>,
-        goal: Vec<Literal>,
+        mut goal: Vec<Literal>,
     ) {
+        // A part in the robot's hand that the task does not use is put back,
+        // not thrown away.
+        if let Some(h) = self.facts.held_by(&self.kb.state, self.agents[a].obj) {
+            let named = goal
+                .iter()
+                .any(|l| l.atom.args.iter().any(|x| x == self.name(h)));
+            if !named {
+                let lit = self.lit(&self.cell.spec.facts.discarded, &[(Var::Part, h)], false);
+                goal.push(lit);
+            }
+        }
         let goal_text = conjunction(&goal);
         let robot = self.agents[a].robot;
         let robot_name = self.cell.robot(robot).object.clone();
@@ -1441,7 +1482,9 @@ impl<'w, 'd> Sim<'w, 'd> {
                 return;
             }
         };
-        // The agent plans for its own robot: the other robots are left out.
+        // The agent plans for its own robot: the other robots are left out,
+        // and so are the kit quadrants and insert slots its goal does not
+        // name (a part in hand goes back to a bin, not into another kit).
         let mut state = self.kb.state.clone();
         for b in &self.agents {
             if b.robot != robot {
@@ -1450,6 +1493,10 @@ impl<'w, 'd> Sim<'w, 'd> {
                     .remove(&self.facts.enabled.key(&[(Var::Robot, b.obj)]));
             }
         }
+        let keep: Vec<Key> = goal.iter().filter_map(|l| self.kit_or_slot_of(l)).collect();
+        state.facts.retain(|k| {
+            !(self.facts.kit_free.is(k) || self.facts.insert_free.is(k)) || keep.contains(k)
+        });
         let tp = Instant::now();
         let domain = self.cell.domain.domain.as_ref().expect("checked");
         let report = btc_planner::plan_from(
@@ -1558,6 +1605,31 @@ impl<'w, 'd> Sim<'w, 'd> {
         ag.engine = Some(engine);
         ag.resources = resources;
         ag.attempt = Some(attempt);
+    }
+
+    /// The free quadrant or insert slot a goal literal needs.
+    fn kit_or_slot_of(&self, l: &Literal) -> Option<Key> {
+        let f = &self.cell.spec.facts;
+        let args: Vec<&str> = l.atom.args.iter().map(String::as_str).collect();
+        let obj = |n: &str| self.pu.index.objects.get(n).map(|o| o.id);
+        if let Some(m) = f.in_kit.matches(&l.atom.pred, &args) {
+            let get = |v: Var| m.iter().find(|(w, _)| *w == v).and_then(|(_, n)| obj(n));
+            return Some(self.facts.kit_free.key(&[
+                (Var::Agv, get(Var::Agv)?),
+                (Var::Quadrant, get(Var::Quadrant)?),
+            ]));
+        }
+        if let Some(m) = f.installed.matches(&l.atom.pred, &args) {
+            let get = |v: Var| m.iter().find(|(w, _)| *w == v).and_then(|(_, n)| obj(n));
+            let kind = self.kind_of(get(Var::Part)?)?;
+            let slot = obj(&self.cell.insert_slot(kind.ty))?;
+            return Some(
+                self.facts
+                    .insert_free
+                    .key(&[(Var::Station, get(Var::Station)?), (Var::Slot, slot)]),
+            );
+        }
+        None
     }
 
     fn note_flipped_use(&mut self, k: usize, t: TaskId) {
