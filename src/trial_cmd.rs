@@ -234,19 +234,20 @@ fn print_report(r: &TrialReport, t: &Trial) {
         );
     }
     println!();
+    // Timings (planning) are in the JSON report only: they vary from run
+    // to run.
     println!(
-        "{:<14} {:>7} {:>10} {:>7} {:>6} {:>10}",
-        "agent", "busy", "tasks done", "failed", "plans", "planning"
+        "{:<14} {:>7} {:>10} {:>7} {:>6}",
+        "agent", "busy", "tasks done", "failed", "plans"
     );
     for a in &r.agents {
         println!(
-            "{:<14} {:>7} {:>10} {:>7} {:>6} {:>10}",
+            "{:<14} {:>7} {:>10} {:>7} {:>6}",
             a.robot,
             format!("{:.0} s", a.busy),
             a.tasks_done,
             a.tasks_failed,
-            a.plans,
-            format!("{:.1} ms", a.planning_ms)
+            a.plans
         );
     }
     if !r.challenges.is_empty() {

@@ -45,25 +45,10 @@ fn every_fixture_reports_its_code() {
 }
 
 /// Codes that no file-sized fixture can trigger, with where they are tested.
-const NO_FIXTURE: &[(&str, &str)] = &[
-    (
-        "F003",
-        "a file over 1 GiB: files::load checks the size first",
-    ),
-    // The trial codes get their fixtures with the `btc trial` command; until
-    // then `agent/src/trial/read.rs`'s tests cover them.
-    ("T001", "btc trial is not in the CLI yet"),
-    ("T002", "btc trial is not in the CLI yet"),
-    ("T003", "btc trial is not in the CLI yet"),
-    ("T004", "btc trial is not in the CLI yet"),
-    ("T005", "btc trial is not in the CLI yet"),
-    ("T006", "btc trial is not in the CLI yet"),
-    ("T007", "btc trial is not in the CLI yet"),
-    ("T008", "btc trial is not in the CLI yet"),
-    ("T009", "btc trial is not in the CLI yet"),
-    ("T010", "btc trial is not in the CLI yet"),
-    ("T011", "btc trial is not in the CLI yet"),
-];
+const NO_FIXTURE: &[(&str, &str)] = &[(
+    "F003",
+    "a file over 1 GiB: files::load checks the size first",
+)];
 
 #[test]
 fn every_code_has_a_fixture() {

@@ -87,40 +87,47 @@ impl Cell {
     fn check(&self, file: FileId) -> Vec<Diagnostic> {
         let dix = &self.domain.index;
         let mut out = Vec::new();
-        let mut bad = |msg: String| {
-            out.push(
-                Diagnostic::error(codes::CELL_MAPPING, Span::new(file, 0, 0), msg).with_hint(
-                    "the cell's `[facts]`, `[types]` and `[always]` must use the predicates and types of its domain",
-                ),
-            )
+        let span = |key: &str| {
+            let r = self.spec.spans.get(key).cloned().unwrap_or(0..0);
+            Span::new(file, r.start, r.end)
         };
-        let mut atoms: Vec<(String, &str, usize)> = self
+        let hint = "the cell's `[facts]`, `[types]` and `[always]` must use the predicates and types of its domain";
+        let mut atoms: Vec<(String, String, &str, usize)> = self
             .spec
             .facts
             .each()
             .iter()
-            .map(|(n, t, _)| (format!("the `{n}` fact"), t.pred.as_str(), t.args.len()))
+            .map(|(n, t, _)| {
+                (
+                    format!("the `{n}` fact"),
+                    (*n).to_owned(),
+                    t.pred.as_str(),
+                    t.args.len(),
+                )
+            })
             .collect();
         for a in &self.spec.always {
             atoms.push((
                 format!("`{a}` in `[always]`"),
+                a.to_string(),
                 a.pred.as_str(),
                 a.args.len(),
             ));
         }
-        for (what, pred, n) in atoms {
-            match dix.predicates.get(pred) {
-                None => bad(format!(
+        for (what, key, pred, n) in atoms {
+            let msg = match dix.predicates.get(pred) {
+                None => format!(
                     "{what} uses `{pred}`, which the domain `{}` does not declare",
                     self.domain_name()
-                )),
-                Some(sig) if sig.params.len() != n => bad(format!(
+                ),
+                Some(sig) if sig.params.len() != n => format!(
                     "{what} gives `{pred}` {n} argument{}; the domain declares {}",
                     if n == 1 { "" } else { "s" },
                     sig.params.len()
-                )),
-                Some(_) => {}
-            }
+                ),
+                Some(_) => continue,
+            };
+            out.push(Diagnostic::error(codes::CELL_MAPPING, span(&key), msg).with_hint(hint));
         }
         let t = &self.spec.types;
         let mut types: Vec<&str> = vec![
@@ -134,10 +141,17 @@ impl Cell {
         types.extend(t.parts.iter().map(String::as_str));
         for ty in types {
             if ty != "object" && dix.types.id(ty).is_none() {
-                bad(format!(
-                    "`[types]` names `{ty}`, which the domain `{}` does not declare",
-                    self.domain_name()
-                ));
+                out.push(
+                    Diagnostic::error(
+                        codes::CELL_MAPPING,
+                        Span::new(file, 0, 0),
+                        format!(
+                            "`[types]` names `{ty}`, which the domain `{}` does not declare",
+                            self.domain_name()
+                        ),
+                    )
+                    .with_hint(hint),
+                );
             }
         }
         out

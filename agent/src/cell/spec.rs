@@ -128,6 +128,9 @@ pub struct CellSpec {
     pub types: Types,
     pub facts: Facts,
     pub always: Vec<GroundAtom>,
+    /// Where each fact (by name) and each `[always]` fact (by its text) is
+    /// written in the cell file, for diagnostics.
+    pub spans: BTreeMap<String, std::ops::Range<usize>>,
 }
 
 #[derive(Deserialize)]
@@ -318,10 +321,19 @@ impl CellSpec {
         let names = Self::names(&f, &mut e);
         let types = Self::types(&f, &mut e);
         let facts = Self::facts(&f, &mut e);
+        let mut spans: BTreeMap<String, std::ops::Range<usize>> = f
+            .facts
+            .iter()
+            .map(|(k, v)| (k.get_ref().clone(), v.span()))
+            .collect();
         let mut always = Vec::new();
         for a in &f.always.facts {
             match AtomTemplate::parse(a.get_ref()) {
-                Ok(t) if t.vars().next().is_none() => always.push(t.ground(&[])),
+                Ok(t) if t.vars().next().is_none() => {
+                    let g = t.ground(&[]);
+                    spans.insert(g.to_string(), a.span());
+                    always.push(g)
+                }
                 Ok(_) => e.at(
                     a.span(),
                     "facts in `[always]` are ground: they have no holes",
@@ -343,6 +355,7 @@ impl CellSpec {
             types,
             facts,
             always,
+            spans,
         })
     }
 
