@@ -615,7 +615,11 @@ impl<'w, 'd> Sim<'w, 'd> {
                     serde_json::json!({"event": "conveyor", "part": name, "what": "arrives"}),
                 );
             }
-            if self.parts[k].leave == Some(tick) {
+            // A part a task has reserved is tracked by its robot and does
+            // not ride off the belt (the symbolic world has no belt speed).
+            if self.parts[k].leave == Some(tick) && self.parts[k].reserved.is_some() {
+                self.parts[k].leave = Some(tick + 1);
+            } else if self.parts[k].leave == Some(tick) {
                 let p = self.parts[k].obj;
                 let on = self
                     .facts
