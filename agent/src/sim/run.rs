@@ -567,7 +567,7 @@ impl<'w, 'd> Sim<'w, 'd> {
         }) {
             return false;
         }
-        let pending_time = |c: &Condition| matches!(c, Condition::Time(t) if self.cell.spec.time.ticks(*t) > self.tick);
+        let pending_time = |c: &Condition| matches!(c, Condition::Time(t) if self.cell.spec.time.ticks(*t) >= self.tick);
         if self
             .trial
             .orders
@@ -678,7 +678,7 @@ impl<'w, 'd> Sim<'w, 'd> {
             let ch = &self.challenges[c];
             if ch.met_at.is_none() {
                 if let Some(Condition::Time(t)) = ch.kind.condition() {
-                    if self.cell.spec.time.ticks(*t).max(1) <= tick {
+                    if self.cell.spec.time.ticks(*t) < tick {
                         self.trigger(c);
                     }
                 }
@@ -693,7 +693,7 @@ impl<'w, 'd> Sim<'w, 'd> {
                 continue;
             }
             let go = match &self.trial.orders[k].announcement {
-                Condition::Time(t) => self.cell.spec.time.ticks(*t).max(1) <= self.tick,
+                Condition::Time(t) => self.cell.spec.time.ticks(*t) < self.tick,
                 // Placements and submissions of the previous tick.
                 Condition::PartPlace { .. } | Condition::Submission(_) => false,
             };
@@ -2283,6 +2283,13 @@ impl<'w, 'd> Sim<'w, 'd> {
         if !self.order_ended(o) {
             return;
         }
+        // ARIAC: a high-priority order is submitted before the regular ones.
+        let priority_open = self.trial.orders.iter().zip(&self.orders).any(|(x, r)| {
+            x.priority && r.announced.is_some() && r.submitted.is_none() && !r.submitting
+        });
+        if !self.trial.orders[o].priority && priority_open {
+            return;
+        }
         match &self.trial.orders[o].task {
             OrderTask::Kitting {
                 agv, destination, ..
@@ -2632,7 +2639,7 @@ impl<'w, 'd> Sim<'w, 'd> {
                 .filter(|c| c.orders.contains(&k) && c.met_at.is_some())
                 .map(|c| FaultMet {
                     challenge: c.label.clone(),
-                    at: self.secs(c.met_at.unwrap_or(0)),
+                    at: self.secs(c.met_at.unwrap_or(1) - 1),
                     ended: challenge_end(
                         c,
                         Some(
@@ -2697,7 +2704,7 @@ impl<'w, 'd> Sim<'w, 'd> {
             .map(|c| ChallengeReport {
                 challenge: c.label.clone(),
                 kind: c.kind.name().to_owned(),
-                met: c.met_at.map(|t| self.secs(t)),
+                met: c.met_at.map(|t| self.secs(t - 1)),
                 ended: challenge_end(c, None),
             })
             .collect();
