@@ -6,6 +6,7 @@ use btc_lang::db;
 use btc_pddl::diagnostic::{has_errors, Diagnostic};
 use btc_pddl::pipeline;
 use btc_pddl::source::{FileId, Sources, Span};
+use btc_pddl::state::World;
 use btc_runtime::{Controller, Engine, Kb, LoadError, Options, Scenario, Summary, TreeDoc};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -145,18 +146,8 @@ fn run_rules(a: &RunArgs, rules: &Path, plan: &Path) -> anyhow::Result<ExitCode>
     }
     let doc = TreeDoc::from_ir(ir);
     let anchor = db::file_id(&database, job.plan(&database));
-    execute(
-        a,
-        &doc,
-        Some(btc_runtime::Kb::new(
-            world.domain,
-            world.dix,
-            world.problem,
-            world.pix,
-        )),
-        &mut sources,
-        anchor,
-    )
+    let world = world.world().map_err(anyhow::Error::msg)?;
+    execute(a, &doc, Some(Kb::new(&world)), &mut sources, anchor)
 }
 
 fn run_tree(a: &RunArgs, tree: &Path) -> anyhow::Result<ExitCode> {
@@ -202,8 +193,10 @@ fn run_tree(a: &RunArgs, tree: &Path) -> anyhow::Result<ExitCode> {
     if has_errors(&diags) {
         return fail(&diags, &sources, a.format);
     }
-    let kb = Kb::new(domain, &du.index, problem, &pu.index);
-    execute(a, &doc, Some(kb), &mut sources, file)
+    let world =
+        World::of_checked(domain, &du.index, problem, &pu.index).map_err(anyhow::Error::msg)?;
+    let doc = doc.with_actions(domain);
+    execute(a, &doc, Some(Kb::new(&world)), &mut sources, file)
 }
 
 fn execute(
