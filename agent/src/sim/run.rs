@@ -157,7 +157,29 @@ impl<'c> Runner<'c> {
             )
             .with_hint("check the cell's `[names]`, `[types]` and `[always]` against its domain")]));
         }
-        let mut sim = Sim::new(self.cell, trial, &tp, &pu, opts, &mut self.db, &self.jobs)?;
+        let world = btc_pddl::state::World::of_checked(
+            self.cell.domain.domain.as_ref().expect("checked"),
+            &self.cell.domain.index,
+            pu.problem.as_ref().expect("checked"),
+            &pu.index,
+        )
+        .map_err(|m| {
+            TrialError::Cell(vec![Diagnostic::error(
+                codes::CELL_MAPPING,
+                Span::new(pid, 0, 0),
+                format!("the trial's PDDL problem cannot be evaluated: {m}"),
+            )])
+        })?;
+        let mut sim = Sim::new(
+            self.cell,
+            trial,
+            &tp,
+            &pu,
+            &world,
+            opts,
+            &mut self.db,
+            &self.jobs,
+        )?;
         sim.run()?;
         let mut report = sim.report(name);
         report.elapsed_ms = t0.elapsed().as_secs_f64() * 1e3;
@@ -240,6 +262,7 @@ struct Sim<'w, 'd> {
     trial: &'w Trial,
     opts: &'w TrialOptions,
     pu: &'w ProblemUnit,
+    world: &'w btc_pddl::state::World,
     db: &'d mut Database,
     kb: Kb<'w>,
     facts: Facts,
@@ -295,14 +318,13 @@ impl<'w, 'd> Sim<'w, 'd> {
         trial: &'w Trial,
         tp: &TrialProblem,
         pu: &'w ProblemUnit,
+        world: &'w btc_pddl::state::World,
         opts: &'w TrialOptions,
         db: &'d mut Database,
         jobs: &[(Robot, CompileJob, String)],
     ) -> Result<Sim<'w, 'd>, TrialError> {
-        let domain = cell.domain.domain.as_ref().expect("checked");
-        let problem = pu.problem.as_ref().expect("checked");
         let pix = &pu.index;
-        let kb = Kb::new(domain, &cell.domain.index, problem, pix);
+        let kb = Kb::new(world);
         let facts = Facts::new(cell, pix).map_err(|m| {
             TrialError::Cell(vec![Diagnostic::error(
                 codes::CELL_MAPPING,
@@ -436,6 +458,7 @@ impl<'w, 'd> Sim<'w, 'd> {
             trial,
             opts,
             pu,
+            world,
             db,
             kb,
             facts,
@@ -1474,8 +1497,18 @@ impl<'w, 'd> Sim<'w, 'd> {
             outcome: String::new(),
             challenges: Vec::new(),
         };
-        let gid = match self.kb.formula(&goal_text) {
-            Ok(g) => g,
+        let goal_f = match btc_pddl::logic::decode::formula(&goal_text) {
+            Ok(f) => f,
+            Err(m) => {
+                attempt.outcome = format!("failed: the goal is not PDDL: {m}");
+                self.tasks[t].attempts.push(attempt);
+                self.fail_task(t, format!("its goal `{goal_text}` is not PDDL: {m}"));
+                return;
+            }
+        };
+        // The goal must fit the domain (it is checked as the KB compiles it).
+        match self.kb.formula(&goal_f) {
+            Ok(_) => {}
             Err(m) => {
                 attempt.outcome = format!("failed: the goal does not fit the domain: {m}");
                 self.tasks[t].attempts.push(attempt);
@@ -1508,7 +1541,7 @@ impl<'w, 'd> Sim<'w, 'd> {
             &self.cell.domain.index,
             &self.pu.index,
             &state,
-            Some(self.kb.formula_ast(gid)),
+            Some(&goal_f.to_ast(Span::new(0, 0, 0))),
             &self.opts.planner,
         );
         let ms = tp.elapsed().as_secs_f64() * 1e3;
@@ -1560,13 +1593,8 @@ impl<'w, 'd> Sim<'w, 'd> {
                 return self.attempt_failed(t, attempt, None);
             }
         };
-        let mut kb = Kb::new(
-            domain,
-            &self.cell.domain.index,
-            self.pu.problem.as_ref().expect("checked"),
-            &self.pu.index,
-        );
-        if let Ok(g) = kb.formula(&goal_text) {
+        let mut kb = Kb::new(self.world);
+        if let Ok(g) = kb.formula(&goal_f) {
             kb.set_goal(g);
         }
         let time = &self.cell.spec.time;
