@@ -331,5 +331,17 @@ pub mod codes {
         X_TOO_DEEP = "X007", "a tree nested deeper than the runtime runs";
         X_REPLAN_UNSOLVABLE = "X008", "a goal that replanning cannot reach after a fault";
         X_REPLAN_LIMIT = "X009", "a closed loop that stopped at its replan or tick limit";
+        // ARIAC trials (btc trial)
+        TRIAL_SYNTAX = "T001", "a trial file that is not YAML btc reads";
+        TRIAL_MISSING = "T002", "a trial field the ARIAC 2023 format requires is missing";
+        TRIAL_VALUE = "T003", "a trial value of the wrong kind or out of range";
+        TRIAL_UNKNOWN_FIELD = "T004", "a trial field the ARIAC 2023 format does not have";
+        TRIAL_NOT_SIMULATED = "T005", "a trial field btc reads but its symbolic world does not simulate";
+        TRIAL_DUPLICATE = "T006", "something given twice in a trial (an order id, a slot, a quadrant)";
+        TRIAL_UNKNOWN_ORDER = "T007", "a condition or challenge naming an order the trial does not have";
+        TRIAL_RULE = "T008", "a trial that breaks an ARIAC 2023 rule";
+        TRIAL_SUPPLY = "T009", "an order the trial's parts cannot fulfil (insufficient parts)";
+        CELL_INVALID = "T010", "a cell file that is not valid";
+        CELL_MAPPING = "T011", "a cell mapping that does not fit the cell's PDDL domain";
     }
 }

@@ -598,6 +598,18 @@ impl<'w> Engine<'w> {
         }
     }
 
+    /// One tick as [`Engine::run`] makes it: once the root is done, the
+    /// failure that ended it (or the goal that does not hold) is recorded.
+    /// The task level (`btc trial`) ticks several engines on one clock this
+    /// way.
+    pub fn step(&mut self) -> Status {
+        let s = self.tick_once();
+        if s != Status::Running {
+            self.finish(s);
+        }
+        s
+    }
+
     /// Ticks like [`Engine::run`], but halts the tree and returns
     /// `(Status::Running, true)` as soon as `stop` says so after a tick
     /// (replanning preempts a plan this way).
