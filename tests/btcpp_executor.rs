@@ -384,4 +384,108 @@ fn generated_executors_run_every_plan_as_btc_run_does() {
     // when it is there); exactly the failing plan's runs fail.
     assert!(compared >= 44, "{compared} runs compared");
     assert_eq!(failed_alike, 2, "only the plan that grasps first fails");
+    palette_written_by_btcpp_imports_and_checks(&exe, &work);
+}
+
+/// The palette BT.CPP writes for the ARIAC executor's factory
+/// (`writeTreeNodesModelXML`) declares the nodes of a rules file that
+/// imports it: it checks, and its tree runs in BT.CPP as the example's
+/// does; a port type from the palette is enforced, shown at the palette.
+fn palette_written_by_btcpp_imports_and_checks(exe: &Path, work: &Path) {
+    let dir = work.join("palette");
+    std::fs::create_dir_all(&dir).unwrap();
+    let palette = Command::new(exe)
+        .args(["ariac", "--palette"])
+        .output()
+        .unwrap();
+    assert_eq!(palette.status.code(), Some(0));
+    let xml = String::from_utf8(palette.stdout).unwrap();
+    assert!(xml.contains("<TreeNodesModel>") && xml.contains("<Action ID=\"Grasp\">"));
+    std::fs::write(dir.join("nodes.xml"), &xml).unwrap();
+    let fixture = repo().join("tests/fixtures/btcpp/palette");
+    for f in ["rules.btrules", "mismatch.btrules"] {
+        std::fs::copy(fixture.join(f), dir.join(f)).unwrap();
+    }
+    let example = repo().join("examples/ariac");
+    std::fs::copy(example.join("domain.pddl"), dir.join("domain.pddl")).unwrap();
+    let path = |f: &str| dir.join(f).to_str().unwrap().to_owned();
+
+    let check = btc(&["check", &path("rules.btrules"), "--format", "json"]);
+    let doc: serde_json::Value = serde_json::from_slice(&check.stdout).unwrap();
+    assert_eq!(doc["ok"], true, "{doc:#}");
+    let codes: Vec<&str> = doc["diagnostics"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|d| d["code"].as_str().unwrap())
+        .collect();
+    assert_eq!(codes, ["P108"], "only the domain's own warning");
+
+    let (plan, problem) = (example.join("plan.txt"), example.join("problem.pddl"));
+    let (plan, problem) = (plan.to_str().unwrap(), problem.to_str().unwrap());
+    let tree = path("tree.xml");
+    let kb = path("world.kb");
+    for (emit, out) in [("btcpp", &tree), ("kb", &kb)] {
+        let c = btc(&[
+            "compile",
+            &path("rules.btrules"),
+            "--plan",
+            plan,
+            "--problem",
+            problem,
+            "--emit",
+            emit,
+            "-o",
+            out,
+        ]);
+        assert_eq!(
+            c.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&c.stderr)
+        );
+    }
+    let trace = path("run.jsonl");
+    let run = btc(&[
+        "run",
+        example.join("rules.btrules").to_str().unwrap(),
+        "--plan",
+        plan,
+        "--problem",
+        problem,
+        "--trace",
+        &trace,
+        "--format",
+        "json",
+    ]);
+    ok(&run, "btc run");
+    let want = from_btc_run(
+        &String::from_utf8_lossy(&run.stdout),
+        &std::fs::read_to_string(&trace).unwrap(),
+    );
+    let ran = Command::new(exe)
+        .args(["ariac", &tree, &kb])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&ran.stdout);
+    assert_eq!(
+        ran.status.code(),
+        Some(0),
+        "{text}{}",
+        String::from_utf8_lossy(&ran.stderr)
+    );
+    assert_eq!(from_executor(&text), want, "{text}");
+
+    let check = btc(&["check", &path("mismatch.btrules"), "--format", "json"]);
+    assert_eq!(check.status.code(), Some(1));
+    let doc: serde_json::Value = serde_json::from_slice(&check.stdout).unwrap();
+    let d = &doc["diagnostics"][0];
+    assert_eq!(d["code"], "R004", "{doc:#}");
+    assert_eq!(d["labels"][0]["file"].as_str().unwrap(), path("nodes.xml"));
+    let line = d["labels"][0]["start"]["line"].as_u64().unwrap() as usize;
+    let declared = xml.lines().nth(line - 1).unwrap();
+    assert!(
+        declared.contains(r#"name="step" type="int""#),
+        "the label is on WaitForStep's port: {declared}"
+    );
 }

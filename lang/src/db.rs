@@ -273,9 +273,13 @@ pub fn normalize(p: &std::path::Path) -> String {
     for c in p.components() {
         match c {
             std::path::Component::CurDir => {}
-            std::path::Component::ParentDir if out.last().is_some_and(|l| l != "..") => {
+            std::path::Component::ParentDir
+                if out.last().is_some_and(|l| l != ".." && !l.is_empty()) =>
+            {
                 out.pop();
             }
+            // An empty first part: joined, the path starts with one `/`.
+            std::path::Component::RootDir => out.push(String::new()),
             other => out.push(other.as_os_str().to_string_lossy().into_owned()),
         }
     }
@@ -573,6 +577,16 @@ mod tests {
             .iter()
             .map(|d| btc_pddl::render::to_short(d, &sources))
             .collect()
+    }
+
+    #[test]
+    fn normalized_paths_keep_one_root_slash() {
+        let n = |p: &str| normalize(std::path::Path::new(p));
+        assert_eq!(n("/tmp/x/./rules.btrules"), "/tmp/x/rules.btrules");
+        assert_eq!(n("/tmp/x/../domain.pddl"), "/tmp/domain.pddl");
+        assert_eq!(n("/../domain.pddl"), "/../domain.pddl");
+        assert_eq!(n("a/./b/../c"), "a/c");
+        assert_eq!(n("../a/b"), "../a/b");
     }
 
     #[test]
