@@ -206,6 +206,63 @@ fn from_btc_run(summary: &str, trace: &str) -> Outcome {
     }
 }
 
+/// `btc compile` to `out`, which must succeed.
+fn compile(rules: &str, plan: &str, problem: &str, emit: &str, out: &str, inline: bool) {
+    let mut args = vec![
+        "compile",
+        rules,
+        "--plan",
+        plan,
+        "--problem",
+        problem,
+        "--emit",
+        emit,
+        "-o",
+        out,
+    ];
+    if inline {
+        args.push("--inline");
+    }
+    let c = btc(&args);
+    assert_eq!(
+        c.status.code(),
+        Some(0),
+        "btc {}: {}",
+        args.join(" "),
+        String::from_utf8_lossy(&c.stderr)
+    );
+}
+
+/// `btc run` with a trace, and what it came to.
+fn btc_run(
+    rules: &str,
+    plan: &str,
+    problem: &str,
+    ticks_per_action: &str,
+    trace: &Path,
+) -> (Output, Outcome) {
+    let run = btc(&[
+        "run",
+        rules,
+        "--plan",
+        plan,
+        "--problem",
+        problem,
+        "--ticks-per-action",
+        ticks_per_action,
+        "--trace",
+        trace.to_str().unwrap(),
+        "--format",
+        "json",
+    ]);
+    ok(&run, "btc run");
+    let outcome = from_btc_run(
+        &String::from_utf8_lossy(&run.stdout),
+        &std::fs::read_to_string(trace).unwrap(),
+    );
+    (run, outcome)
+}
+
 /// The test's executable: every rule set's generated nodes, one `main`.
 fn all_executors(sets: &[RuleSet], dir: &Path) -> String {
     let mut src = String::from(
@@ -279,66 +336,15 @@ fn generated_executors_run_every_plan_as_btc_run_does() {
             let problem = job.problem.to_str().unwrap();
             let stem = work.join(format!("{}-{j}", s.name));
             let kb = stem.with_extension("kb");
-            let out = btc(&[
-                "compile",
-                rules,
-                "--plan",
-                plan,
-                "--problem",
-                problem,
-                "--emit",
-                "kb",
-                "-o",
-                kb.to_str().unwrap(),
-            ]);
-            assert_eq!(
-                out.status.code(),
-                Some(0),
-                "{}",
-                String::from_utf8_lossy(&out.stderr)
-            );
+            compile(rules, plan, problem, "kb", kb.to_str().unwrap(), false);
             for ticks in std::iter::once(1).chain(job.ticks.iter().copied()) {
                 let tpa = ticks.to_string();
                 let trace = stem.with_extension(format!("t{ticks}.jsonl"));
-                let run = btc(&[
-                    "run",
-                    rules,
-                    "--plan",
-                    plan,
-                    "--problem",
-                    problem,
-                    "--ticks-per-action",
-                    &tpa,
-                    "--trace",
-                    trace.to_str().unwrap(),
-                    "--format",
-                    "json",
-                ]);
-                ok(&run, "btc run");
-                let want = from_btc_run(
-                    &String::from_utf8_lossy(&run.stdout),
-                    &std::fs::read_to_string(&trace).unwrap(),
-                );
+                let (run, want) = btc_run(rules, plan, problem, &tpa, &trace);
                 for inline in [false, true] {
                     let xml = stem.with_extension(if inline { "inline.xml" } else { "xml" });
-                    let mut args = vec![
-                        "compile",
-                        rules,
-                        "--plan",
-                        plan,
-                        "--problem",
-                        problem,
-                        "--emit",
-                        "btcpp",
-                        "-o",
-                    ];
                     let xml_s = xml.to_str().unwrap().to_owned();
-                    args.push(&xml_s);
-                    if inline {
-                        args.push("--inline");
-                    }
-                    let out = btc(&args);
-                    assert_eq!(out.status.code(), Some(0));
+                    compile(rules, plan, problem, "btcpp", &xml_s, inline);
                     let ran = Command::new(&exe)
                         .args([
                             &s.name,
@@ -425,44 +431,11 @@ fn palette_written_by_btcpp_imports_and_checks(exe: &Path, work: &Path) {
     let (plan, problem) = (plan.to_str().unwrap(), problem.to_str().unwrap());
     let tree = path("tree.xml");
     let kb = path("world.kb");
-    for (emit, out) in [("btcpp", &tree), ("kb", &kb)] {
-        let c = btc(&[
-            "compile",
-            &path("rules.btrules"),
-            "--plan",
-            plan,
-            "--problem",
-            problem,
-            "--emit",
-            emit,
-            "-o",
-            out,
-        ]);
-        assert_eq!(
-            c.status.code(),
-            Some(0),
-            "{}",
-            String::from_utf8_lossy(&c.stderr)
-        );
-    }
-    let trace = path("run.jsonl");
-    let run = btc(&[
-        "run",
-        example.join("rules.btrules").to_str().unwrap(),
-        "--plan",
-        plan,
-        "--problem",
-        problem,
-        "--trace",
-        &trace,
-        "--format",
-        "json",
-    ]);
-    ok(&run, "btc run");
-    let want = from_btc_run(
-        &String::from_utf8_lossy(&run.stdout),
-        &std::fs::read_to_string(&trace).unwrap(),
-    );
+    compile(&path("rules.btrules"), plan, problem, "btcpp", &tree, false);
+    compile(&path("rules.btrules"), plan, problem, "kb", &kb, false);
+    let example_rules = example.join("rules.btrules");
+    let trace = dir.join("run.jsonl");
+    let (_, want) = btc_run(example_rules.to_str().unwrap(), plan, problem, "1", &trace);
     let ran = Command::new(exe)
         .args(["ariac", &tree, &kb])
         .output()

@@ -287,15 +287,6 @@ fn node(x: &mut Xml, n: &Node, ir: &TreeIr) {
     }
 }
 
-fn port_type(ty: &str) -> &str {
-    match ty {
-        "int" => "int",
-        "float" => "double",
-        "bool" => "bool",
-        _ => "std::string",
-    }
-}
-
 /// The XML document for a compiled plan.
 pub fn emit(ir: &TreeIr, inline: bool) -> String {
     // Sized up front: growing a buffer of tens of megabytes by doubling
@@ -343,7 +334,7 @@ pub fn emit(ir: &TreeIr, inline: bool) -> String {
             };
             x.open(kind)
                 .attr("name", &p.name)
-                .attr("type", port_type(&p.ty));
+                .attr("type", p.cpp_type());
             if !matches!(p.ty.as_str(), "int" | "float" | "bool" | "string") {
                 x.attr("description", &format!("a PDDL object of type {}", p.ty));
             }

@@ -359,15 +359,6 @@ fn comment(s: &str) -> String {
     s.replace(['\n', '\r'], " ")
 }
 
-fn cpp_type(ty: &str) -> &'static str {
-    match ty {
-        "int" => "int",
-        "float" => "double",
-        "bool" => "bool",
-        _ => "std::string",
-    }
-}
-
 fn port_type_enum(ty: &str) -> &'static str {
     match ty {
         "int" => "btc::PortType::Int",
@@ -546,7 +537,7 @@ fn base_class(out: &mut String, m: &NodeModel) {
             out,
             "{}\n      BT::{dir}<{}>({}, {})",
             if i > 0 { "," } else { "" },
-            cpp_type(&p.ty),
+            p.cpp_type(),
             literal(&p.name),
             literal(&port_description(&p.ty))
         );
@@ -556,7 +547,7 @@ fn base_class(out: &mut String, m: &NodeModel) {
         out.push_str("\nprotected:\n");
     }
     for (p, a) in m.ports.iter().zip(&names) {
-        let ty = cpp_type(&p.ty);
+        let ty = p.cpp_type();
         let what = match port_description(&p.ty) {
             d if d.is_empty() => String::new(),
             d => format!(": {d}"),

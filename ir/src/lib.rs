@@ -127,6 +127,20 @@ pub struct PortModel {
     pub ty: String,
 }
 
+impl PortModel {
+    /// The C++ type BT.CPP holds the port's values in (and names in a
+    /// TreeNodesModel): `int`, `double` for `float`, `bool`, and
+    /// `std::string` for strings and PDDL objects.
+    pub fn cpp_type(&self) -> &'static str {
+        match self.ty.as_str() {
+            "int" => "int",
+            "float" => "double",
+            "bool" => "bool",
+            _ => "std::string",
+        }
+    }
+}
+
 /// A leaf node type the tree uses, with its ports (BT.CPP's TreeNodesModel).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct NodeModel {

@@ -226,16 +226,6 @@ fn support_model(id: &str) -> Option<Model> {
     Some(Model { element: e })
 }
 
-/// The C++ type BT.CPP names for a port of a btc model.
-fn cpp_type(ty: &str) -> &'static str {
-    match ty {
-        "int" => "int",
-        "float" => "double",
-        "bool" => "bool",
-        _ => "std::string",
-    }
-}
-
 fn doc_model(m: &btc_ir::NodeModel) -> Model {
     let kind = match m.kind {
         LeafKind::Action => "Action",
@@ -249,7 +239,7 @@ fn doc_model(m: &btc_ir::NodeModel) -> Model {
         };
         let mut port = Element::new(dir)
             .attr("name", p.name.clone())
-            .attr("type", cpp_type(&p.ty));
+            .attr("type", p.cpp_type());
         // As the executor's generated bases describe a PDDL-typed port.
         if !matches!(p.ty.as_str(), "int" | "float" | "bool" | "string") {
             port.text = Some(format!("a PDDL object of type {}", p.ty));
@@ -510,16 +500,7 @@ mod tests {
     use crate::engine::Options;
 
     fn leaf(id: &str) -> SNode {
-        SNode {
-            kind: Kind::Leaf {
-                id: id.into(),
-                kind: None,
-                ports: Vec::new(),
-            },
-            name: None,
-            children: Vec::new(),
-            at: None,
-        }
+        SNode::leaf(id)
     }
 
     fn doc(root: SNode) -> TreeDoc {

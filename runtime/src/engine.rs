@@ -2062,16 +2062,7 @@ mod tests {
     }
 
     fn leaf(id: &str) -> SNode {
-        SNode {
-            kind: Kind::Leaf {
-                id: id.into(),
-                kind: None,
-                ports: Vec::new(),
-            },
-            name: None,
-            children: Vec::new(),
-            at: None,
-        }
+        SNode::leaf(id)
     }
 
     #[test]

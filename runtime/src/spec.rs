@@ -68,6 +68,22 @@ pub struct SNode {
     pub at: Option<usize>,
 }
 
+impl SNode {
+    /// A leaf without ports, name or source position.
+    pub fn leaf(id: &str) -> SNode {
+        SNode {
+            kind: Kind::Leaf {
+                id: id.into(),
+                kind: None,
+                ports: Vec::new(),
+            },
+            name: None,
+            children: Vec::new(),
+            at: None,
+        }
+    }
+}
+
 /// A whole document: its trees, the leaf models and the plan steps.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TreeDoc {
