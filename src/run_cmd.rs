@@ -299,7 +299,14 @@ fn execute(
         pb
     });
     let pace = Duration::from_millis(a.tick_ms);
+    // The trace goes out tick by tick: bounded memory, and a killed run
+    // leaves every line so far (SIGINT/SIGTERM flush it).
+    let trace = a.trace.as_deref().map(files::stream).transpose()?;
     let status = engine.run(a.max_ticks, |e| {
+        if let Some(t) = &trace {
+            let mut w: &btc_files::Stream = t;
+            let _ = e.drain_trace(&mut w).and_then(|()| t.flush());
+        }
         if let Some(pb) = &bar {
             pb.set_position(e.steps_done() as u64);
             pb.set_message(format!("tick {}", e.tick));
@@ -312,8 +319,11 @@ fn execute(
         pb.finish_and_clear();
     }
     let commands = engine.take_controller().map(Controller::shutdown);
-    if let Some(path) = &a.trace {
-        files::write_atomically(path, &engine.trace_jsonl())?;
+    if let (Some(t), Some(path)) = (trace, &a.trace) {
+        let mut w: &btc_files::Stream = &t;
+        let _ = engine.drain_trace(&mut w);
+        t.finish()
+            .map_err(|e| anyhow::anyhow!("cannot write `{}`: {e}", path.display()))?;
     }
     let summary = engine.summary(status);
     match a.format {
@@ -417,13 +427,24 @@ fn run_replan(a: &RunArgs, rules: &Path) -> anyhow::Result<ExitCode> {
         max_replans: a.max_replans,
         max_ticks: a.max_ticks,
     };
-    let result = btc_agent::run_loop(
+    let trace = a.trace.as_deref().map(files::stream).transpose()?;
+    let mut sink: Box<dyn std::io::Write> = match &trace {
+        Some(t) => Box::new(t),
+        None => Box::new(std::io::sink()),
+    };
+    let result = btc_agent::run_loop_traced(
         &mut database,
         job,
         a.plan.is_some(),
         scenario.as_ref().map(|(s, _)| s),
         &opts,
+        &mut sink,
     );
+    drop(sink);
+    if let (Some(t), Some(path)) = (trace, &a.trace) {
+        t.finish()
+            .map_err(|e| anyhow::anyhow!("cannot write `{}`: {e}", path.display()))?;
+    }
     let sources = database.sources();
     let summary = match result {
         Ok(s) => s,
@@ -440,9 +461,6 @@ fn run_replan(a: &RunArgs, rules: &Path) -> anyhow::Result<ExitCode> {
             return fail(&[diagnostic(&e, f, &scen_sources)], &scen_sources, a.format);
         }
     };
-    if let Some(path) = &a.trace {
-        files::write_atomically(path, &summary.trace)?;
-    }
     match a.format {
         Format::Json => {
             let mut v = serde_json::to_value(&summary)?;

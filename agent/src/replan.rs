@@ -167,6 +167,24 @@ pub fn run_loop(
     scenario: Option<&Scenario>,
     opts: &LoopOptions,
 ) -> Result<LoopSummary, LoopError> {
+    let mut trace = Vec::new();
+    let mut out = run_loop_traced(db, job, given_plan, scenario, opts, &mut trace)?;
+    out.trace = String::from_utf8_lossy(&trace).into_owned();
+    Ok(out)
+}
+
+/// [`run_loop`] with the trace (when `opts.engine.trace` is set) written to
+/// `trace` as it happens, tick by tick, instead of kept in the summary: a
+/// long loop holds bounded memory and a killed one leaves its trace so far.
+/// Write errors are the writer's to keep (`btc_files::Stream` does).
+pub fn run_loop_traced(
+    db: &mut Database,
+    job: CompileJob,
+    given_plan: bool,
+    scenario: Option<&Scenario>,
+    opts: &LoopOptions,
+    trace_out: &mut dyn std::io::Write,
+) -> Result<LoopSummary, LoopError> {
     let t0 = Instant::now();
     let plan_path = job.plan(db).path(db).clone();
     let goal_span = world(db, job)?.problem.goal.as_ref().map_or(
@@ -341,7 +359,7 @@ pub fn run_loop(
         let plan: Vec<String> = ir.steps.iter().map(|s| s.display()).collect();
         if trace {
             push_event(
-                &mut out.trace,
+                trace_out,
                 serde_json::json!({
                     "event": "plan", "attempt": attempt, "tick": carry.tick,
                     "source": if plan_text.is_some() { "planned" } else { "given" },
@@ -368,6 +386,9 @@ pub fn run_loop(
         let tr = Instant::now();
         // A high-priority order whose goal does not hold preempts the plan.
         let (status, preempted) = engine.run_until(opts.max_ticks, |e| {
+            if trace {
+                let _ = e.drain_trace(trace_out);
+            }
             e.kb.as_ref()
                 .is_some_and(|kb| !kb.unmet_extra_goals().is_empty())
         });
@@ -400,7 +421,7 @@ pub fn run_loop(
             .collect();
         out.faults = engine.fault_outcomes(done);
         if trace {
-            out.trace.push_str(&engine.trace_jsonl());
+            let _ = engine.drain_trace(trace_out);
         }
         let discarded = engine.discarded_parts();
         let kb = engine.kb.as_mut().expect("built with a KB");
@@ -536,7 +557,7 @@ pub fn run_loop(
             if let Some(o) = v.as_object_mut() {
                 o.insert("event".into(), "replan".into());
             }
-            push_event(&mut out.trace, v);
+            push_event(trace_out, v);
         }
         out.replans.push(rp);
     }
@@ -544,7 +565,7 @@ pub fn run_loop(
     out.elapsed_ms = t0.elapsed().as_secs_f64() * 1e3;
     if trace {
         push_event(
-            &mut out.trace,
+            trace_out,
             serde_json::json!({
                 "event": "goal_check", "tick": out.ticks, "goal": out.goal,
                 "reached": out.goal_reached, "replans": out.replans.len(),
@@ -554,9 +575,8 @@ pub fn run_loop(
     Ok(out)
 }
 
-fn push_event(out: &mut String, v: serde_json::Value) {
-    out.push_str(&v.to_string());
-    out.push('\n');
+fn push_event(out: &mut dyn std::io::Write, v: serde_json::Value) {
+    let _ = writeln!(out, "{v}");
 }
 
 fn plural(n: usize, what: &str) -> String {

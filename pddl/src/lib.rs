@@ -12,6 +12,7 @@ pub mod ast;
 pub mod check;
 pub mod diagnostic;
 pub mod lexer;
+pub mod limits;
 pub mod logic;
 pub mod parse;
 pub mod pipeline;

@@ -9,7 +9,7 @@ use crate::error::LoadError;
 use crate::faults::FaultRt;
 use crate::kb::{ConditionId, EffectId, FormulaId, Kb};
 use crate::spec::{default_name, Kind, SNode, TreeDoc};
-use btc_ir::{LeafKind, PortValue};
+use btc_ir::{LeafKind, NodeModel, PortValue};
 use btc_pddl::diagnostic::{codes, did_you_mean};
 use btc_pddl::logic::{self, Binding, Effect, Formula, Name, Terms};
 use rustc_hash::FxHashMap;
@@ -322,6 +322,10 @@ type Scope = FxHashMap<String, u32>;
 
 struct Builder<'d, 'e, 'w> {
     doc: &'d TreeDoc,
+    /// The document's trees and node models by ID: looking them up in the
+    /// lists per node made loading quadratic.
+    trees: FxHashMap<&'d str, &'d SNode>,
+    models: FxHashMap<&'d str, &'d NodeModel>,
     e: &'e mut Engine<'w>,
     instances: FxHashMap<String, u32>,
     /// The tree instance being built (`Main`, `Check#1`): names new entries.
@@ -382,6 +386,19 @@ impl<'w> Engine<'w> {
         }
         let mut b = Builder {
             doc,
+            // The first definition of an ID counts, as `TreeDoc::tree` has it.
+            trees: doc
+                .trees
+                .iter()
+                .rev()
+                .map(|(id, n)| (id.as_str(), n))
+                .collect(),
+            models: doc
+                .models
+                .iter()
+                .rev()
+                .map(|m| (m.id.as_str(), m))
+                .collect(),
             e: &mut e,
             instances: FxHashMap::default(),
             tree: doc.main.clone(),
@@ -533,7 +550,11 @@ impl<'w> Engine<'w> {
 
     /// Ticks until the root is no longer RUNNING, or `max_ticks` have run
     /// (then the tree is halted). `each` sees the engine after every tick.
-    pub fn run(&mut self, max_ticks: u64, mut each: impl FnMut(&Engine<'w>)) -> Status {
+    pub fn run(&mut self, max_ticks: u64, mut each: impl FnMut(&mut Engine<'w>)) -> Status {
+        if max_ticks == 0 {
+            self.finish(Status::Running);
+            return Status::Running;
+        }
         loop {
             let s = self.tick_once();
             each(self);
@@ -552,14 +573,30 @@ impl<'w> Engine<'w> {
         }
     }
 
+    /// One tick as [`Engine::run`] makes it: once the root is done, the
+    /// failure that ended it (or the goal that does not hold) is recorded.
+    /// The task level (`btc trial`) ticks several engines on one clock this
+    /// way.
+    pub fn step(&mut self) -> Status {
+        let s = self.tick_once();
+        if s != Status::Running {
+            self.finish(s);
+        }
+        s
+    }
+
     /// Ticks like [`Engine::run`], but halts the tree and returns
     /// `(Status::Running, true)` as soon as `stop` says so after a tick
     /// (replanning preempts a plan this way).
     pub fn run_until(
         &mut self,
         max_ticks: u64,
-        mut stop: impl FnMut(&Engine<'w>) -> bool,
+        mut stop: impl FnMut(&mut Engine<'w>) -> bool,
     ) -> (Status, bool) {
+        if max_ticks == 0 {
+            self.finish(Status::Running);
+            return (Status::Running, false);
+        }
         loop {
             let s = self.tick_once();
             if s != Status::Running {
@@ -1235,7 +1272,32 @@ impl<'w> Engine<'w> {
     pub fn trace_jsonl(&self) -> String {
         let mut out = String::new();
         for t in &self.trace {
-            let v = match t {
+            out.push_str(&self.trace_line(t).to_string());
+            out.push('\n');
+        }
+        out
+    }
+
+    /// Writes the trace so far as JSON Lines and forgets it, so that a long
+    /// run streams its trace in bounded memory (`btc run --trace` calls this
+    /// after every tick).
+    pub fn drain_trace(&mut self, out: &mut dyn std::io::Write) -> std::io::Result<()> {
+        let items = std::mem::take(&mut self.trace);
+        let mut line = Vec::new();
+        for t in &items {
+            line.clear();
+            serde_json::to_writer(&mut line, &self.trace_line(t))?;
+            line.push(b'\n');
+            out.write_all(&line)?;
+        }
+        self.trace = items;
+        self.trace.clear();
+        Ok(())
+    }
+
+    fn trace_line(&self, t: &TraceItem) -> serde_json::Value {
+        {
+            match t {
                 TraceItem::Status {
                     tick,
                     node,
@@ -1274,11 +1336,8 @@ impl<'w> Engine<'w> {
                     "tick": tick, "event": "command", "seq": seq, "node": node,
                     "command": self.meta[*node as usize].id,
                 }),
-            };
-            out.push_str(&v.to_string());
-            out.push('\n');
+            }
         }
-        out
     }
 }
 
@@ -1501,7 +1560,7 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
                     "a SubTree has no children of its own".into(),
                 ));
             }
-            let Some(def) = self.doc.tree(tid) else {
+            let Some(def) = self.trees.get(tid.as_str()).copied() else {
                 let hint = did_you_mean(tid, self.doc.trees.iter().map(|(t, _)| t.as_str()));
                 let mut e = self.err(
                     codes::X_SUBTREE,
@@ -1836,7 +1895,7 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
             }
             _ => {}
         }
-        let model = self.doc.model(id);
+        let model = self.models.get(id).copied();
         let kind = kind.or(model.map(|m| m.kind)).ok_or_else(|| {
             let known = self.doc.models.iter().map(|m| m.id.as_str()).chain(BUILTIN_LEAVES.iter().copied());
             let mut e = self.err(
