@@ -3,6 +3,7 @@
 
 mod executor_cmd;
 mod files;
+mod paths;
 mod pddl_cmd;
 mod plan_cmd;
 mod report;

@@ -218,9 +218,18 @@ pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
         }
         return Ok(ExitCode::from(1));
     };
-    let text = match a.emit {
-        Output::Tree(f) => emit::emit(ir, f, &a.options),
-        Output::Kb => match db::JobWorld::of(&database, job) {
+    let text = match (&a.output, a.emit) {
+        // A JSON IR records its PDDL files relative to itself.
+        (Some(out), Output::Tree(f @ emit::Format::Json)) => {
+            let mut ir = ir.clone();
+            let dir = out.parent().unwrap_or(Path::new(""));
+            for p in [&mut ir.domain, &mut ir.problem] {
+                *p = crate::paths::text(&crate::paths::relative_to(Path::new(p.as_str()), dir));
+            }
+            emit::emit(&ir, f, &a.options)
+        }
+        (_, Output::Tree(f)) => emit::emit(ir, f, &a.options),
+        (_, Output::Kb) => match db::JobWorld::of(&database, job) {
             Some(w) => emit::kb::emit(w.domain, w.dix, w.problem, w.pix),
             None => anyhow::bail!(
                 "`--emit kb` needs the PDDL problem: pass `--problem PROBLEM` or name it in the rules file"

@@ -510,7 +510,12 @@ fn base_class(out: &mut String, m: &NodeModel) {
             out,
             "  /// The condition's formula over its ports (empty: it always holds).\n  \
              static constexpr const char* formula = {};\n",
-            literal(m.formula.as_deref().unwrap_or(""))
+            literal(
+                &m.formula
+                    .as_ref()
+                    .map(ToString::to_string)
+                    .unwrap_or_default()
+            )
         );
     }
     let _ = write!(

@@ -320,6 +320,7 @@ pub mod codes {
         R_UNKNOWN_TYPE = "R021", "a port type that is neither a PDDL type nor a basic type";
         R_PLAN_BLOCK = "R022", "a `plan` block that is missing, repeated or has no `steps`";
         R_BAD_ARGUMENT = "R023", "a control or decorator argument that makes no sense";
+        R_EFFECT_UNBOUND = "R033", "a rule effect that reads an optional parameter a step leaves out";
         R_TOO_DEEP = "R060", "a template nested deeper than btc supports";
         // Node palettes imported from BT.CPP XML (`import "nodes.xml"`)
         R_PALETTE = "R070", "an imported node palette that is not BT.CPP XML with a <TreeNodesModel>";
@@ -334,6 +335,7 @@ pub mod codes {
         X_TOO_DEEP = "X007", "a tree nested deeper than the runtime runs";
         X_REPLAN_UNSOLVABLE = "X008", "a goal that replanning cannot reach after a fault";
         X_REPLAN_LIMIT = "X009", "a closed loop that stopped at its replan or tick limit";
+        X_WORLD = "X010", "a JSON IR whose world is missing or does not fit together";
         X_BTLOG = "X030", "a run that a Groot2 `.btlog` file cannot hold";
         // The C++ executor for BehaviorTree.CPP (`btc executor`)
         C_CLASS_NAME = "C001", "a node whose name cannot become a C++ class of the executor";

@@ -292,10 +292,10 @@ impl Writer<'_, '_> {
                 conditions,
             } => {
                 let info = self.doc.steps.get(*step);
-                let text = |given: Option<&String>, planned: Option<&String>| {
-                    given.or(planned).cloned().unwrap_or_default()
-                };
-                let c = conditions.clone().unwrap_or_default();
+                fn text<T: std::fmt::Display>(given: Option<&T>, planned: Option<&T>) -> String {
+                    given.or(planned).map(T::to_string).unwrap_or_default()
+                }
+                let c = conditions.as_deref().cloned().unwrap_or_default();
                 vec![
                     ("step".into(), (step + 1).to_string()),
                     (
