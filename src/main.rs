@@ -38,7 +38,10 @@ pub enum Format {
     Json,
 }
 
+// `defer`: a subcommand's arguments are built only when it is the one
+// run, so `btc --version` and each command do not build all the others.
 #[derive(Subcommand)]
+#[command(defer = true)]
 enum Command {
     /// Parse and check PDDL domains and problems.
     Pddl {
