@@ -40,6 +40,7 @@ pub mod heuristic;
 pub mod improve;
 pub mod lifted;
 pub mod lmcut;
+mod reach;
 pub mod search;
 pub mod task;
 
