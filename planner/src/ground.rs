@@ -847,6 +847,7 @@ fn ground_with(
             }
         }
     }
+    let fact_preds = g.fact_keys.iter().map(|k| k[0]).collect();
     let fact_names = g
         .fact_keys
         .iter()
@@ -872,6 +873,7 @@ fn ground_with(
     };
     let mut task = Task {
         fact_names,
+        fact_preds,
         derived: is_derived,
         operators: ops,
         axioms,
@@ -889,6 +891,7 @@ fn ground_with(
             positive: true,
         }];
         task.fact_names.push("(false)".into());
+        task.fact_preds.push(u32::MAX);
         task.derived.push(true);
         task.goal[0].fact = (task.fact_names.len() - 1) as u32;
         task.words = task.fact_names.len().div_ceil(64);

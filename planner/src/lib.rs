@@ -38,7 +38,11 @@
 pub mod ground;
 pub mod heuristic;
 pub mod improve;
+pub mod lama;
+pub mod landmarks;
+pub mod lazy;
 pub mod lifted;
+pub mod lmcount;
 pub mod lmcut;
 mod reach;
 pub mod search;
@@ -46,7 +50,7 @@ pub mod task;
 
 pub use ground::GroundStats;
 pub use heuristic::Heuristic;
-pub use search::{Algorithm, Options, SearchStats};
+pub use search::{Algorithm, Options, SearchStats, DEFAULT_IMPROVE};
 
 use btc_pddl::ast::{Domain, Formula, InitFact, Problem};
 use btc_pddl::check::{DomainIndex, ProblemIndex};
