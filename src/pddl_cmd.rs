@@ -34,7 +34,11 @@ pub fn run(
                 let unit = domain_unit(&sources, id);
                 diags.extend(unit.diagnostics.iter().cloned());
                 if let Some(d) = &unit.domain {
-                    models.push(serde_json::json!({ "file": path, "kind": "domain", "model": d }));
+                    if json {
+                        models.push(
+                            serde_json::json!({ "file": path, "kind": "domain", "model": d }),
+                        );
+                    }
                     format!(
                         "domain {}: {}, {}, {}",
                         d.name.name,
@@ -74,7 +78,9 @@ pub fn run(
                         );
                     }
                 }
-                models.push(serde_json::json!({ "file": path, "kind": "problem", "model": p }));
+                if json {
+                    models.push(serde_json::json!({ "file": path, "kind": "problem", "model": p }));
+                }
                 format!(
                     "problem {} (domain {}): {}, {}",
                     p.name.name,
@@ -138,6 +144,9 @@ fn find_domain(problem: &Path, name: &str) -> Option<PathBuf> {
     entries.sort();
     entries.into_iter().find(|p| {
         p.extension().is_some_and(|e| e.eq_ignore_ascii_case("pddl"))
-            && std::fs::read_to_string(p).is_ok_and(|t| matches!(pddl::parse_document(&t, 0).0, Some(Document::Domain(d)) if d.name.name == name))
+            && btc_files::read(p, btc_pddl::source::MAX_FILE_BYTES).is_ok_and(|bytes| {
+                let text = btc_pddl::source::decode(&bytes).0;
+                matches!(pddl::parse_document(&text, 0).0, Some(Document::Domain(d)) if d.name.name == name)
+            })
     })
 }

@@ -1069,7 +1069,9 @@ mod tests {
                     &du.index,
                 );
                 let prob = pu.problem.as_ref().unwrap();
-                let init = World::new(dom, &du.index, &pu.index).initial_state(prob);
+                let init = World::of_checked(dom, &du.index, prob, &pu.index)
+                    .expect("a world")
+                    .initial_state();
                 let run = |f| {
                     ground_with(
                         dom,
