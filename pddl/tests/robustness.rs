@@ -215,6 +215,9 @@ fn stray_words_make_a_bounded_number_of_diagnostics() {
     for text in ["\0 ".repeat(200_000), "word ".repeat(200_000)] {
         let (_, diags) = btc_pddl::parse_document(&text, 0);
         assert!(diags.len() <= 110, "{}", diags.len());
-        assert!(diags.iter().any(|d| d.message.contains("more")), "{diags:#?}");
+        assert!(
+            diags.iter().any(|d| d.message.contains("more")),
+            "{diags:#?}"
+        );
     }
 }
