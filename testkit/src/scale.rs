@@ -60,7 +60,7 @@ pub fn domain(n: usize) -> String {
 /// rules file) with one rule per action.
 pub fn rules(n: usize, domain_path: &str) -> String {
     let mut s = format!(
-        "domain \"{domain_path}\"\n\naction MoveTo(robot: robot, target: location)\naction Grasp(robot: robot, part: part)\naction Place(robot: robot, part: part, target: location)\naction Inspect(robot: robot, at: location)\naction Report(message: string)\ncondition Free(robot: robot) = (free ?robot)\n\ntable speed {{ FAST: 2, SLOW: 1 }}\n\ntree Approach(robot: robot, target: location) {{\n    retry(3) MoveTo(robot: ?robot, target: ?target)\n}}\n\n"
+        "domain \"{domain_path}\"\n\naction MoveTo(robot: robot, target: location)\naction Grasp(robot: robot, part: part)\naction Place(robot: robot, part: part, target: location)\naction Inspect(robot: robot, at: location)\naction Report(message: string)\ncondition Free(robot: robot) = (free ?robot)\n\ntree Approach(robot: robot, target: location) {{\n    retry(3) MoveTo(robot: ?robot, target: ?target)\n}}\n\n"
     );
     for i in 0..n {
         let name = action_name(i);
