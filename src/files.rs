@@ -1,8 +1,10 @@
 //! Reading input files into [`Sources`], with encoding problems reported as
-//! diagnostics rather than failures.
+//! diagnostics rather than failures, and writing outputs. Every command's
+//! files go through here, and through `btc_files` underneath: one bounded
+//! reader, one writer.
 
 use btc_pddl::diagnostic::{codes, Diagnostic};
-use btc_pddl::source::{decode, DecodeProblem, FileId, Sources, Span};
+use btc_pddl::source::{decode, DecodeProblem, FileId, Sources, Span, MAX_FILE_BYTES};
 use std::path::Path;
 
 /// A file's text as read from disk, and what was wrong with it.
@@ -14,24 +16,43 @@ struct Read {
 
 /// Reads and decodes a file. `Err` only when it cannot be read at all.
 fn read(path: &Path) -> anyhow::Result<Read> {
-    let len = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
-    if len > btc_pddl::source::MAX_FILE_BYTES as u64 {
-        return Ok(Read {
+    match btc_files::read(path, MAX_FILE_BYTES) {
+        Ok(bytes) => {
+            let (text, problem) = decode_owned(bytes);
+            Ok(Read { text, problem })
+        }
+        Err(btc_files::ReadError::TooLarge { known, .. }) => Ok(Read {
             text: String::new(),
             problem: Some(DecodeProblem::TooLarge {
-                bytes: len as usize,
+                bytes: known.map_or(MAX_FILE_BYTES + 1, |n| n as usize),
             }),
-        });
-    }
-    let bytes = std::fs::read(path).map_err(|e| {
-        anyhow::anyhow!(
+        }),
+        Err(e @ btc_files::ReadError::NotAFile { .. }) => Err(anyhow::anyhow!(
+            "[{}] cannot read `{}`: {e}",
+            codes::FILE_NOT_REGULAR.id,
+            path.display()
+        )),
+        Err(btc_files::ReadError::Io(e)) => Err(anyhow::anyhow!(
             "[{}] cannot read `{}`: {e}",
             codes::FILE_UNREADABLE.id,
             path.display()
-        )
-    })?;
-    let (text, problem) = decode(&bytes);
-    Ok(Read { text, problem })
+        )),
+    }
+}
+
+/// [`decode`] without copying a UTF-8 file's bytes.
+fn decode_owned(bytes: Vec<u8>) -> (String, Option<DecodeProblem>) {
+    let plain = !bytes.starts_with(&[0xEF, 0xBB, 0xBF])
+        && !bytes.starts_with(&[0xFF, 0xFE])
+        && !bytes.starts_with(&[0xFE, 0xFF]);
+    if plain {
+        match String::from_utf8(bytes) {
+            Ok(s) => (s, None),
+            Err(e) => decode(e.as_bytes()),
+        }
+    } else {
+        decode(&bytes)
+    }
 }
 
 /// Reads a file into the database (under its normalized path), reporting
@@ -67,21 +88,17 @@ fn decode_diagnostic(id: FileId, problem: DecodeProblem) -> Diagnostic {
     }
 }
 
-/// Writes `text` to `path` through a temporary file in the same folder and
-/// a rename, so a failed run never leaves a half-written output.
+/// Writes an output file (`-o`, `fmt`): atomically for a regular file,
+/// keeping its mode, owner and links; in place for special files.
 pub fn write_atomically(path: &Path, text: &str) -> anyhow::Result<()> {
-    use std::io::Write;
-    let dir = path
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let mut tmp = tempfile::NamedTempFile::new_in(dir)
-        .map_err(|e| anyhow::anyhow!("cannot write in `{}`: {e}", dir.display()))?;
-    tmp.write_all(text.as_bytes())?;
-    tmp.as_file().sync_all()?;
-    tmp.persist(path)
-        .map_err(|e| anyhow::anyhow!("cannot write `{}`: {}", path.display(), e.error))?;
-    Ok(())
+    btc_files::write(path, text.as_bytes())
+        .map_err(|e| anyhow::anyhow!("cannot write `{}`: {e}", path.display()))
+}
+
+/// Opens an output that is written as it is produced (`--trace`).
+pub fn stream(path: &Path) -> anyhow::Result<btc_files::Stream> {
+    btc_files::Stream::create(path)
+        .map_err(|e| anyhow::anyhow!("cannot write `{}`: {e}", path.display()))
 }
 
 /// Reads a file. `Err` only when it cannot be read at all.
@@ -99,12 +116,11 @@ pub fn load(
 }
 
 fn too_large(id: FileId, bytes: u64) -> Diagnostic {
-    Diagnostic::error(
-        codes::FILE_TOO_LARGE,
-        Span::new(id, 0, 0),
-        format!(
-            "this file has {bytes} bytes; btc reads files of at most {} bytes",
-            btc_pddl::source::MAX_FILE_BYTES
-        ),
-    )
+    // A stream that went on past the limit has no known size.
+    let message = if bytes == MAX_FILE_BYTES as u64 + 1 {
+        format!("this input goes on past {MAX_FILE_BYTES} bytes, the most btc reads")
+    } else {
+        format!("this file has {bytes} bytes; btc reads files of at most {MAX_FILE_BYTES} bytes")
+    };
+    Diagnostic::error(codes::FILE_TOO_LARGE, Span::new(id, 0, 0), message)
 }

@@ -6,6 +6,7 @@ use btc_lang::db;
 use btc_pddl::diagnostic::{has_errors, Diagnostic};
 use btc_pddl::pipeline;
 use btc_pddl::source::{FileId, Sources, Span};
+use btc_pddl::state::World;
 use btc_runtime::{Controller, Engine, Kb, LoadError, Options, Scenario, Summary, TreeDoc};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -145,18 +146,8 @@ fn run_rules(a: &RunArgs, rules: &Path, plan: &Path) -> anyhow::Result<ExitCode>
     }
     let doc = TreeDoc::from_ir(ir);
     let anchor = db::file_id(&database, job.plan(&database));
-    execute(
-        a,
-        &doc,
-        Some(btc_runtime::Kb::new(
-            world.domain,
-            world.dix,
-            world.problem,
-            world.pix,
-        )),
-        &mut sources,
-        anchor,
-    )
+    let world = world.world().map_err(anyhow::Error::msg)?;
+    execute(a, &doc, Some(Kb::new(&world)), &mut sources, anchor)
 }
 
 fn run_tree(a: &RunArgs, tree: &Path) -> anyhow::Result<ExitCode> {
@@ -202,8 +193,10 @@ fn run_tree(a: &RunArgs, tree: &Path) -> anyhow::Result<ExitCode> {
     if has_errors(&diags) {
         return fail(&diags, &sources, a.format);
     }
-    let kb = Kb::new(domain, &du.index, problem, &pu.index);
-    execute(a, &doc, Some(kb), &mut sources, file)
+    let world =
+        World::of_checked(domain, &du.index, problem, &pu.index).map_err(anyhow::Error::msg)?;
+    let doc = doc.with_actions(domain);
+    execute(a, &doc, Some(Kb::new(&world)), &mut sources, file)
 }
 
 fn execute(
@@ -245,7 +238,14 @@ fn execute(
         pb
     });
     let pace = Duration::from_millis(a.tick_ms);
+    // The trace goes out tick by tick: bounded memory, and a killed run
+    // leaves every line so far (SIGINT/SIGTERM flush it).
+    let trace = a.trace.as_deref().map(files::stream).transpose()?;
     let status = engine.run(a.max_ticks, |e| {
+        if let Some(t) = &trace {
+            let mut w: &btc_files::Stream = t;
+            let _ = e.drain_trace(&mut w).and_then(|()| t.flush());
+        }
         if let Some(pb) = &bar {
             pb.set_position(e.steps_done() as u64);
             pb.set_message(format!("tick {}", e.tick));
@@ -258,8 +258,11 @@ fn execute(
         pb.finish_and_clear();
     }
     let commands = engine.take_controller().map(Controller::shutdown);
-    if let Some(path) = &a.trace {
-        files::write_atomically(path, &engine.trace_jsonl())?;
+    if let (Some(t), Some(path)) = (trace, &a.trace) {
+        let mut w: &btc_files::Stream = &t;
+        let _ = engine.drain_trace(&mut w);
+        t.finish()
+            .map_err(|e| anyhow::anyhow!("cannot write `{}`: {e}", path.display()))?;
     }
     let summary = engine.summary(status);
     match a.format {
@@ -363,13 +366,24 @@ fn run_replan(a: &RunArgs, rules: &Path) -> anyhow::Result<ExitCode> {
         max_replans: a.max_replans,
         max_ticks: a.max_ticks,
     };
-    let result = btc_agent::run_loop(
+    let trace = a.trace.as_deref().map(files::stream).transpose()?;
+    let mut sink: Box<dyn std::io::Write> = match &trace {
+        Some(t) => Box::new(t),
+        None => Box::new(std::io::sink()),
+    };
+    let result = btc_agent::run_loop_traced(
         &mut database,
         job,
         a.plan.is_some(),
         scenario.as_ref().map(|(s, _)| s),
         &opts,
+        &mut sink,
     );
+    drop(sink);
+    if let (Some(t), Some(path)) = (trace, &a.trace) {
+        t.finish()
+            .map_err(|e| anyhow::anyhow!("cannot write `{}`: {e}", path.display()))?;
+    }
     let sources = database.sources();
     let summary = match result {
         Ok(s) => s,
@@ -386,9 +400,6 @@ fn run_replan(a: &RunArgs, rules: &Path) -> anyhow::Result<ExitCode> {
             return fail(&[diagnostic(&e, f, &scen_sources)], &scen_sources, a.format);
         }
     };
-    if let Some(path) = &a.trace {
-        files::write_atomically(path, &summary.trace)?;
-    }
     match a.format {
         Format::Json => {
             let mut v = serde_json::to_value(&summary)?;

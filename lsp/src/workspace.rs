@@ -16,7 +16,7 @@ use tower_lsp::lsp_types::TextDocumentContentChangeEvent;
 
 /// Files larger than this are not read from disk (the CLI's limit is 1 GiB;
 /// an editor has no use for more than this).
-const MAX_DISK_FILE: u64 = 64 << 20;
+const MAX_DISK_FILE: usize = 64 << 20;
 
 pub struct Workspace {
     pub db: Database,
@@ -25,7 +25,14 @@ pub struct Workspace {
     /// Paths that had diagnostics at the last publication: they get an empty
     /// list when their problems are gone.
     published: BTreeSet<String>,
+    /// Open documents over [`MAX_ANALYSED`]: their text (edits still apply)
+    /// while the database holds them empty.
+    oversize: BTreeMap<String, String>,
 }
+
+/// The largest document the server analyses; a larger one gets one
+/// diagnostic (F006) saying so, and is otherwise left alone.
+pub const MAX_ANALYSED: usize = 16 << 20;
 
 /// One file's diagnostics, ready to publish.
 pub struct FileDiagnostics {
@@ -46,6 +53,7 @@ impl Workspace {
             db: Database::new(),
             open: BTreeMap::new(),
             published: BTreeSet::new(),
+            oversize: BTreeMap::new(),
         }
     }
 
@@ -58,7 +66,21 @@ impl Workspace {
     }
 
     pub fn text(&self, path: &str) -> Option<&str> {
+        if let Some(t) = self.oversize.get(path) {
+            return Some(t);
+        }
         self.db.file(path).map(|f| f.text(&self.db).as_str())
+    }
+
+    /// An editor's text into the database, unless it is too large to analyse.
+    fn set_document(&mut self, path: &str, text: String) {
+        if text.len() > MAX_ANALYSED {
+            self.db.set_file(path, String::new());
+            self.oversize.insert(path.to_owned(), text);
+        } else {
+            self.oversize.remove(path);
+            self.db.set_file(path, text);
+        }
     }
 
     pub fn is_open(&self, path: &str) -> bool {
@@ -67,7 +89,7 @@ impl Workspace {
 
     pub fn open(&mut self, path: &str, text: String, version: i32) {
         self.open.insert(path.to_owned(), version);
-        self.db.set_file(path, text);
+        self.set_document(path, text);
         self.load_dependencies(path);
     }
 
@@ -92,13 +114,14 @@ impl Workspace {
             }
         }
         self.open.insert(path.to_owned(), version);
-        self.db.set_file(path, text);
+        self.set_document(path, text);
         self.load_dependencies(path);
     }
 
     /// The editor closed a document: what is on disk counts again.
     pub fn close(&mut self, path: &str) {
         self.open.remove(path);
+        self.oversize.remove(path);
         self.reload_from_disk(path);
     }
 
@@ -247,6 +270,20 @@ impl Workspace {
                 }
             }
         }
+        for (p, t) in &self.oversize {
+            let Some(f) = self.db.file(p) else { continue };
+            let id = file_id(&self.db, f);
+            // Only this: the (empty) text the database holds says nothing.
+            by_path.insert(p.clone(), Vec::new());
+            by_path.entry(p.clone()).or_default().push(Diagnostic::error(
+                btc_pddl::diagnostic::codes::DOCUMENT_TOO_LARGE,
+                btc_pddl::source::Span::new(id, 0, 0),
+                format!(
+                    "this document has {} bytes; the language server analyses documents of at most {MAX_ANALYSED} bytes",
+                    t.len()
+                ),
+            ).with_hint("`btc check` reads files up to 1 GiB"));
+        }
         let mut out = Vec::new();
         let now: BTreeSet<String> = by_path
             .iter()
@@ -281,12 +318,10 @@ impl Workspace {
     }
 }
 
-/// A file's text from disk, or `None` when it cannot be read as text.
+/// A file's text from disk, or `None` when it cannot be read as text
+/// (through the CLI's bounded reader: devices and folders are refused,
+/// nothing is read past the limit).
 fn read(path: &Path) -> Option<String> {
-    let meta = std::fs::metadata(path).ok()?;
-    if !meta.is_file() || meta.len() > MAX_DISK_FILE {
-        return None;
-    }
-    let bytes = std::fs::read(path).ok()?;
+    let bytes = btc_files::read(path, MAX_DISK_FILE).ok()?;
     Some(btc_pddl::source::decode(&bytes).0)
 }

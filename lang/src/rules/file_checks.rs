@@ -172,7 +172,7 @@ pub enum Finding {
 pub fn structure(heads: &[ItemHead]) -> Vec<Finding> {
     let mut out = Vec::new();
     let domains: Vec<usize> = positions(heads, HeadKind::Domain);
-    if domains.is_empty() && !heads.is_empty() {
+    if domains.is_empty() {
         out.push(Finding::NoDomain);
     }
     out.extend(
