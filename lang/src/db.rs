@@ -248,19 +248,23 @@ fn resolve(db: &dyn Db, from: SourceFile, written: &str) -> Option<SourceFile> {
     candidates.iter().find_map(|c| files.get(c).copied())
 }
 
-/// `a/./b/../c` -> `a/c`, without touching the file system.
+/// `a/./b/../c` -> `a/c`, without touching the file system; `/`
+/// separators, and an absolute path keeps its one leading `/`.
 pub fn normalize(p: &std::path::Path) -> String {
-    let mut out: Vec<String> = Vec::new();
+    use std::path::Component;
+    let mut out = std::path::PathBuf::new();
     for c in p.components() {
         match c {
-            std::path::Component::CurDir => {}
-            std::path::Component::ParentDir if out.last().is_some_and(|l| l != "..") => {
+            Component::CurDir => {}
+            Component::ParentDir
+                if matches!(out.components().next_back(), Some(Component::Normal(_))) =>
+            {
                 out.pop();
             }
-            other => out.push(other.as_os_str().to_string_lossy().into_owned()),
+            other => out.push(other),
         }
     }
-    out.join("/")
+    out.to_string_lossy().replace('\\', "/")
 }
 
 /// The path a rules file gives for its domain (or problem), as written.
