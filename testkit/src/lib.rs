@@ -11,6 +11,7 @@
 //! harness's output capture, so `cargo test` shows it for passing tests too.
 
 pub mod hostile;
+pub mod scale;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
