@@ -4,8 +4,9 @@
 //! - `btc --version` (target: under 1 ms);
 //! - `btc plan` on the ARIAC per-part problem against `pyperplan`
 //!   (target: at least 40 times faster);
-//! - `btc plan` on every corpus problem and the held-out problems in
-//!   `planner/benches/heldout/` against Fast Downward's `lama-first` (from
+//! - `btc plan` on every corpus problem and the held-out problems
+//!   (`BTC_HELDOUT`, default `target/heldout/`, which
+//!   `planner/benches/heldout.sh` assembles) against Fast Downward's `lama-first` (from
 //!   the `up-fast-downward` wheel; `BTC_FAST_DOWNWARD` names another
 //!   `fast-downward.py`): time at most lama-first's, plan cost at most its
 //!   cost.
@@ -255,7 +256,17 @@ fn corpus() {
     if all.is_empty() {
         println!("corpus: {} is not there, skipped", corpus.display());
     }
-    all.extend(cases(&repo().join("planner/benches/heldout"), "heldout/"));
+    let heldout = std::env::var_os("BTC_HELDOUT")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| repo().join("target/heldout"));
+    let held = cases(&heldout, "heldout/");
+    if held.is_empty() {
+        println!(
+            "held-out problems: {} is not there, skipped (planner/benches/heldout.sh assembles them)",
+            heldout.display()
+        );
+    }
+    all.extend(held);
     all.retain(|c| c.name.contains(&filter));
     let fd = fast_downward();
     let dir = scratch("corpus");

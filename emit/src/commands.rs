@@ -16,7 +16,7 @@ fn port_json(v: &PortValue) -> Value {
         PortValue::Int(n) => json!(n),
         PortValue::Float(f) => json!(f),
         PortValue::Bool(b) => json!(b),
-        PortValue::Param(p) => json!(format!("{{{p}}}")),
+        PortValue::Param(_) | PortValue::Formula(_) | PortValue::Effect(_) => json!(v.to_text()),
     }
 }
 
@@ -41,8 +41,9 @@ fn walk(n: &Node, step: Option<usize>, ir: &TreeIr, out: &mut Vec<Value>) {
         Node::Decorator {
             decorator, child, ..
         } => {
+            // A count left as a port (a call btc could not inline) runs once.
             let times = match decorator {
-                DecoratorKind::Repeat { times } => *times,
+                DecoratorKind::Repeat { times } => times.fixed().unwrap_or(1),
                 _ => 1,
             };
             for _ in 0..times {

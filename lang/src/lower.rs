@@ -7,13 +7,22 @@
 use crate::rules::ast::*;
 use crate::rules::check::Decls;
 use crate::rules::matching::{match_args, match_name, Bindings, Captures, ObjectTypes};
+use crate::rules::name::{capture_value, Key};
 use btc_ir::format_float;
 use btc_ir::*;
-use btc_pddl::ast::{Action, Domain, Effect, Formula, Problem, Term};
+use btc_pddl::ast::{Domain, Problem};
 use btc_pddl::check::{DomainIndex, ProblemIndex};
 use btc_pddl::diagnostic::{codes, Diagnostic};
+use btc_pddl::logic::{self, Formula, Name};
 use btc_pddl::plan::{GroundStep, Plan};
+use btc_pddl::world::WorldModel;
 use std::collections::{BTreeMap, BTreeSet};
+
+mod action;
+mod arrange;
+
+use action::{ActionLogic, RuleEffect};
+use arrange::kb_holds;
 
 pub struct LowerInput<'a> {
     pub decls: &'a Decls,
@@ -44,260 +53,6 @@ impl ObjectTypes for Types<'_> {
     }
 }
 
-/// A PDDL formula or effect with its action's parameters cut out, so a step's
-/// ground text is a concatenation instead of a fresh formatting.
-#[derive(Clone, Debug)]
-struct Spliced(Vec<Seg>);
-
-#[derive(Clone, Debug)]
-enum Seg {
-    Lit(String),
-    Arg(usize),
-}
-
-const MARK: char = '\u{1}';
-
-impl Spliced {
-    fn new(text: &str) -> Spliced {
-        let mut segs = Vec::new();
-        for (i, part) in text.split(MARK).enumerate() {
-            if i % 2 == 0 {
-                if !part.is_empty() {
-                    segs.push(Seg::Lit(part.to_owned()));
-                }
-            } else {
-                segs.push(Seg::Arg(part.parse().expect("marker holds an index")));
-            }
-        }
-        Spliced(segs)
-    }
-
-    fn ground(&self, args: &[String]) -> String {
-        let mut s = String::new();
-        for seg in &self.0 {
-            match seg {
-                Seg::Lit(l) => s.push_str(l),
-                Seg::Arg(i) => s.push_str(&args[*i]),
-            }
-        }
-        s
-    }
-}
-
-/// Replaces an action's parameters by markers in a formula or effect.
-fn mark_params<T: Clone + serde::Serialize + serde::de::DeserializeOwned>(
-    x: &T,
-    action: &Action,
-) -> T {
-    // Through JSON: one generic walk over every `Term::Var`.
-    let mut v = serde_json::to_value(x).expect("model serializes");
-    fn walk(v: &mut serde_json::Value, action: &Action) {
-        match v {
-            serde_json::Value::Object(m) => {
-                if m.get("kind").and_then(|k| k.as_str()) == Some("var") {
-                    if let Some(name) = m
-                        .get("name")
-                        .and_then(|n| n.get("name"))
-                        .and_then(|n| n.as_str())
-                    {
-                        if let Some(i) = action.params.iter().position(|p| p.name.name == name) {
-                            m.insert("kind".into(), "const".into());
-                            m["name"]["name"] = format!("{MARK}{i}{MARK}").into();
-                        }
-                    }
-                }
-                m.values_mut().for_each(|x| walk(x, action));
-            }
-            serde_json::Value::Array(a) => a.iter_mut().for_each(|x| walk(x, action)),
-            _ => {}
-        }
-    }
-    walk(&mut v, action);
-    serde_json::from_value(v).expect("same shape")
-}
-
-fn conj(parts: &[Formula]) -> Option<String> {
-    (!parts.is_empty()).then(|| btc_pddl::print::conjunction(parts))
-}
-
-fn effs(parts: &[Effect]) -> Option<String> {
-    let non_empty: Vec<&Effect> = parts
-        .iter()
-        .filter(|e| !matches!(e, Effect::And { parts, .. } if parts.is_empty()))
-        .collect();
-    match non_empty.as_slice() {
-        [] => None,
-        [one] => Some(one.to_string()),
-        many => Some(format!(
-            "(and {})",
-            many.iter()
-                .map(|e| e.to_string())
-                .collect::<Vec<_>>()
-                .join(" ")
-        )),
-    }
-}
-
-/// An action's conditions and effects, ready to be grounded.
-struct ActionTexts {
-    pre_start: Option<Spliced>,
-    pre_over_all: Option<Spliced>,
-    pre_end: Option<Spliced>,
-    eff_start: Option<Spliced>,
-    eff_end: Option<Spliced>,
-    /// Effects as a condition ("already done"), for `steps backchained`.
-    done: Option<Spliced>,
-    /// Literals (positive?, predicate, arg slots) when conditions and effects
-    /// are plain conjunctions; `None` otherwise (ordered conservatively).
-    literals: Option<Literals>,
-}
-
-#[derive(Clone, Debug, Default)]
-struct Literals {
-    pre: Vec<(bool, String, Vec<Slot>)>,
-    eff: Vec<(bool, String, Vec<Slot>)>,
-}
-
-#[derive(Clone, Debug)]
-enum Slot {
-    Param(usize),
-    Const(String),
-}
-
-fn slots(args: &[Term], action: &Action) -> Option<Vec<Slot>> {
-    args.iter()
-        .map(|t| match t {
-            Term::Var { name } => action
-                .params
-                .iter()
-                .position(|p| p.name.name == name.name)
-                .map(Slot::Param),
-            Term::Const { name } => Some(Slot::Const(name.name.clone())),
-        })
-        .collect()
-}
-
-fn formula_literals(
-    f: &Formula,
-    action: &Action,
-    out: &mut Vec<(bool, String, Vec<Slot>)>,
-) -> Option<()> {
-    match f {
-        Formula::Atom { atom } => {
-            out.push((true, atom.pred.name.clone(), slots(&atom.args, action)?))
-        }
-        Formula::Not { formula, .. } => match &**formula {
-            Formula::Atom { atom } => {
-                out.push((false, atom.pred.name.clone(), slots(&atom.args, action)?))
-            }
-            Formula::Equal { .. } => {}
-            _ => return None,
-        },
-        Formula::And { parts, .. } => {
-            for p in parts {
-                formula_literals(p, action, out)?;
-            }
-        }
-        Formula::Equal { .. } => {}
-        _ => return None,
-    }
-    Some(())
-}
-
-fn effect_literals(
-    e: &Effect,
-    action: &Action,
-    out: &mut Vec<(bool, String, Vec<Slot>)>,
-) -> Option<()> {
-    match e {
-        Effect::Add { atom } => {
-            out.push((true, atom.pred.name.clone(), slots(&atom.args, action)?))
-        }
-        Effect::Delete { atom, .. } => {
-            out.push((false, atom.pred.name.clone(), slots(&atom.args, action)?))
-        }
-        Effect::And { parts, .. } => {
-            for p in parts {
-                effect_literals(p, action, out)?;
-            }
-        }
-        // Action costs never order steps: increases commute.
-        Effect::Numeric { fluent, .. } if fluent.pred.name == "total-cost" => {}
-        _ => return None,
-    }
-    Some(())
-}
-
-impl ActionTexts {
-    fn new(a: &Action) -> ActionTexts {
-        let sp = |t: Option<String>| t.map(|t| Spliced::new(&t));
-        let pre_start: Vec<Formula> = a.pre_start.iter().map(|f| mark_params(f, a)).collect();
-        let over: Vec<Formula> = a.pre_over_all.iter().map(|f| mark_params(f, a)).collect();
-        let pre_end: Vec<Formula> = a.pre_end.iter().map(|f| mark_params(f, a)).collect();
-        let eff_start: Vec<Effect> = a.eff_start.iter().map(|e| mark_params(e, a)).collect();
-        let eff_end: Vec<Effect> = a.eff_end.iter().map(|e| mark_params(e, a)).collect();
-        let mut lits = Literals::default();
-        let simple = a
-            .pre_start
-            .iter()
-            .chain(&a.pre_over_all)
-            .chain(&a.pre_end)
-            .all(|f| formula_literals(f, a, &mut lits.pre).is_some())
-            && a.eff_start
-                .iter()
-                .chain(&a.eff_end)
-                .all(|e| effect_literals(e, a, &mut lits.eff).is_some());
-        // "Already done": the net effect as a condition, when it is plain.
-        let mut net = Vec::new();
-        let done = if eff_start
-            .iter()
-            .chain(&eff_end)
-            .all(|e| effect_literals(e, a, &mut net).is_some())
-            && !net.is_empty()
-        {
-            let mut marked_net = Vec::new();
-            for e in eff_start.iter().chain(&eff_end) {
-                collect_marked(e, &mut marked_net);
-            }
-            // A later literal on the same atom wins (add after delete).
-            let mut last: Vec<(bool, String)> = Vec::new();
-            for (pos, atom) in marked_net {
-                last.retain(|(_, a)| *a != atom);
-                last.push((pos, atom));
-            }
-            let parts: Vec<String> = last
-                .into_iter()
-                .map(|(pos, atom)| if pos { atom } else { format!("(not {atom})") })
-                .collect();
-            Some(if parts.len() == 1 {
-                parts[0].clone()
-            } else {
-                format!("(and {})", parts.join(" "))
-            })
-        } else {
-            None
-        };
-        ActionTexts {
-            pre_start: sp(conj(&pre_start)),
-            pre_over_all: sp(conj(&over)),
-            pre_end: sp(conj(&pre_end)),
-            eff_start: sp(effs(&eff_start)),
-            eff_end: sp(effs(&eff_end)),
-            done: sp(done),
-            literals: simple.then_some(lits),
-        }
-    }
-}
-
-fn collect_marked(e: &Effect, out: &mut Vec<(bool, String)>) {
-    match e {
-        Effect::Add { atom } => out.push((true, atom.to_string())),
-        Effect::Delete { atom, .. } => out.push((false, atom.to_string())),
-        Effect::And { parts, .. } => parts.iter().for_each(|p| collect_marked(p, out)),
-        _ => {}
-    }
-}
-
 /// A rule's template made parametric: its tree and, per parameter, the
 /// value expression a call evaluates.
 struct RuleTree {
@@ -305,6 +60,8 @@ struct RuleTree {
     params: Vec<(String, Value)>,
     root: Node,
     typed: Vec<TypedPort>,
+    /// Parameters that are decorator counts, with their ranges.
+    counts: Vec<(String, DecoratorName, DecoratorParam)>,
 }
 
 /// Instantiates templates, either with a step's bindings (values filled in)
@@ -321,6 +78,8 @@ struct Inst<'a> {
     used_trees: BTreeSet<String>,
     /// Nesting of tree expansions (a tree may call trees).
     depth: usize,
+    /// Parameters that are decorator counts, checked at each call.
+    counts: Vec<(String, DecoratorName, DecoratorParam)>,
 }
 
 /// A tree declaration's body with the call's argument expressions put in
@@ -328,7 +87,7 @@ struct Inst<'a> {
 fn expand_tree(decl: &TreeDecl, args: &[Arg]) -> Vec<Template> {
     let arg = |port: &str| -> Option<&Value> {
         args.iter()
-            .find(|a| a.port.text.to_lowercase() == port)
+            .find(|a| a.port.key.as_str() == port)
             .map(|a| &a.value)
     };
     fn value<'a>(v: &Value, arg: &dyn Fn(&str) -> Option<&'a Value>) -> Value {
@@ -389,11 +148,20 @@ fn expand_tree(decl: &TreeDecl, args: &[Arg]) -> Vec<Template> {
             },
             Template::Decorator {
                 decorator,
+                args,
                 name,
                 child,
                 span,
             } => Template::Decorator {
                 decorator: *decorator,
+                args: args
+                    .iter()
+                    .map(|a| DecoratorArg {
+                        param: a.param.clone(),
+                        value: value(&a.value, arg),
+                        span: a.span,
+                    })
+                    .collect(),
                 name: name.as_ref().map(|n| string(n, arg)),
                 child: Box::new(template(child, arg)),
                 span: *span,
@@ -477,11 +245,9 @@ impl Inst<'_> {
                 }
                 PortValue::Text(self.lookup_var(&name.text).unwrap_or_default().to_owned())
             }
-            Value::Name { name } => PortValue::Text(
-                self.lookup_capture(&name.text)
-                    .unwrap_or(&name.text)
-                    .to_uppercase(),
-            ),
+            Value::Name { name } => PortValue::Text(capture_value(
+                self.lookup_capture(&name.text).unwrap_or(&name.text),
+            )),
             Value::Str { value } => PortValue::Text(self.string(value)),
             Value::Int { value, .. } => PortValue::Int(*value),
             Value::Float { value, .. } => PortValue::Float(*value),
@@ -491,11 +257,11 @@ impl Inst<'_> {
                     PortValue::Text(t) => t,
                     other => other.to_text(),
                 };
-                let entry = self.decls.tables.get(&table.text).and_then(|t| {
-                    t.entries
-                        .iter()
-                        .find(|e| e.key.text.eq_ignore_ascii_case(&key))
-                });
+                let entry = self
+                    .decls
+                    .tables
+                    .get(&table.text)
+                    .and_then(|t| t.entries.iter().find(|e| e.key.key == Key::new(&key)));
                 match entry.map(|e| &e.value) {
                     Some(Literal::Int { value, .. }) => PortValue::Int(*value),
                     Some(Literal::Float { value, .. }) => PortValue::Float(*value),
@@ -524,7 +290,7 @@ impl Inst<'_> {
                     }
                 },
                 StrPart::Capture { name } => match self.lookup_capture(&name.text) {
-                    Some(c) if self.params.is_none() => out.push_str(&c.to_uppercase()),
+                    Some(c) if self.params.is_none() => out.push_str(&capture_value(c)),
                     _ => {
                         out.push('{');
                         out.push_str(&name.text);
@@ -556,6 +322,50 @@ impl Inst<'_> {
         Some(self.string(s))
     }
 
+    /// A decorator of the IR: its argument evaluated, or (in a rule's
+    /// parametric tree, when it depends on the step) a parameter of the
+    /// tree that each step's call fills in. The checker has made sure the
+    /// argument is a whole number in range (R004, R023).
+    fn decorator(&mut self, d: DecoratorName, args: &[DecoratorArg]) -> DecoratorKind {
+        let count = |this: &mut Self, param: &str| -> Count {
+            let (Some(a), Some(range)) = (args.first(), d.param()) else {
+                return Count::Fixed(0);
+            };
+            let v = this.value(&a.value, param);
+            if let Some(n) = count_in_range(&v, range) {
+                return Count::Fixed(n);
+            }
+            // A parameter, or (in a rule's tree) a value the checker could
+            // not see; each call's value is checked where the step is.
+            let p = match v {
+                PortValue::Param(p) => p,
+                _ if this.params.is_some() => match this.param_for(&a.value, param) {
+                    PortValue::Param(p) => p,
+                    _ => unreachable!("param_for gives a parameter"),
+                },
+                _ => return Count::Fixed(0),
+            };
+            if this.params.is_some() && this.tree_ports.is_empty() {
+                this.counts.push((p.clone(), d, range));
+            }
+            Count::Param { param: p }
+        };
+        match d {
+            DecoratorName::Retry => DecoratorKind::Retry {
+                times: count(self, "times"),
+            },
+            DecoratorName::Repeat => DecoratorKind::Repeat {
+                times: count(self, "times"),
+            },
+            DecoratorName::Timeout => DecoratorKind::Timeout {
+                ms: count(self, "msec"),
+            },
+            DecoratorName::Inverter => DecoratorKind::Inverter,
+            DecoratorName::ForceSuccess => DecoratorKind::ForceSuccess,
+            DecoratorName::ForceFailure => DecoratorKind::ForceFailure,
+        }
+    }
+
     fn templates(&mut self, ts: &[Template], steps: &dyn Fn(StepsMode) -> Vec<Node>) -> Vec<Node> {
         ts.iter().flat_map(|t| self.template(t, steps)).collect()
     }
@@ -577,11 +387,13 @@ impl Inst<'_> {
             }
             Template::Decorator {
                 decorator,
+                args,
                 name,
                 child,
                 ..
             } => {
                 let name = self.name(name);
+                let kind = self.decorator(*decorator, args);
                 let mut kids = self.template(child, steps);
                 let child = if kids.len() == 1 {
                     kids.remove(0)
@@ -589,7 +401,7 @@ impl Inst<'_> {
                     Node::sequence(kids)
                 };
                 vec![Node::Decorator {
-                    decorator: *decorator,
+                    decorator: kind,
                     name,
                     child: Box::new(child),
                 }]
@@ -632,6 +444,19 @@ impl Inst<'_> {
             Template::Error { .. } => Vec::new(),
         }
     }
+}
+
+/// A value as a decorator's count, when it is a whole number in range.
+fn count_in_range(v: &PortValue, range: DecoratorParam) -> Option<u64> {
+    let n = match v {
+        PortValue::Int(n) => *n,
+        PortValue::Text(t) => t.parse().ok()?,
+        _ => return None,
+    };
+    (range.min..=range.max)
+        .contains(&n)
+        .then(|| u64::try_from(n).ok())
+        .flatten()
 }
 
 /// A value's identity without its spans: two uses of `?robot` are one
@@ -683,18 +508,6 @@ fn rule_id(r: &Rule, taken: &BTreeSet<String>) -> String {
     id
 }
 
-fn kb_leaf(leaf: LeafKind, id: &str, port: &str, value: String, name: Option<String>) -> Node {
-    Node::Leaf {
-        leaf,
-        id: id.to_owned(),
-        name,
-        ports: vec![Port {
-            name: port.to_owned(),
-            value: PortValue::Text(value),
-        }],
-    }
-}
-
 /// Lowers a plan; every problem is reported at the plan line of its step.
 pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
     let mut diags = Vec::new();
@@ -703,7 +516,8 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
         pix: input.pix,
     };
     let tables = |name: &str| input.decls.tables.get(name).cloned();
-    let mut texts: BTreeMap<usize, ActionTexts> = BTreeMap::new();
+    let mut actions: BTreeMap<usize, ActionLogic> = BTreeMap::new();
+    let mut rule_effects: BTreeMap<usize, RuleEffect> = BTreeMap::new();
     let mut rule_trees: Vec<(usize, RuleTree)> = Vec::new(); // by rule index
     let mut taken = BTreeSet::new();
     let mut used_nodes = BTreeSet::new();
@@ -713,39 +527,39 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
     let mut step_nodes: Vec<Option<Node>> = Vec::with_capacity(input.steps.len());
     let no_bindings = Bindings::new();
     let no_captures = Captures::new();
+    let object_names: Vec<Name> = input
+        .pix
+        .object_names
+        .iter()
+        .map(|n| logic::name(n))
+        .collect();
 
     for (k, g) in input.steps.iter().enumerate() {
         let step = &input.plan.steps[g.step];
         let action = &input.domain.actions[g.action];
-        let args: Vec<String> = g
+        let objects: Vec<Name> = g
             .args
             .iter()
-            .map(|&o| input.pix.object_names[o as usize].clone())
+            .map(|&o| object_names[o as usize].clone())
             .collect();
-        let t = texts
+        let ground = actions
             .entry(g.action)
-            .or_insert_with(|| ActionTexts::new(action));
-        let ground = |s: &Option<Spliced>| s.as_ref().map(|s| s.ground(&args));
-        let (pre_start, pre_over_all, pre_end) = (
-            ground(&t.pre_start),
-            ground(&t.pre_over_all),
-            ground(&t.pre_end),
-        );
-        let (eff_start, eff_end) = (ground(&t.eff_start), ground(&t.eff_end));
+            .or_insert_with(|| ActionLogic::new(action))
+            .ground(&objects);
         let mut info = StepInfo {
             index: k,
             line: step.line,
             action: action.name.name.clone(),
-            args,
+            args: objects.iter().map(|o| o.to_string()).collect(),
             time: step.time,
             duration: step.duration,
             rule: None,
             skipped: false,
-            pre_start,
-            pre_over_all,
-            pre_end,
-            eff_start,
-            eff_end,
+            pre_start: ground.pre_start,
+            pre_over_all: ground.pre_over_all,
+            pre_end: ground.pre_end,
+            eff_start: ground.eff_start,
+            eff_end: ground.eff_end,
             after: Vec::new(),
         };
         let args = &info.args;
@@ -792,12 +606,38 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
             step_nodes.push(None);
             continue;
         };
-        let RuleBody::Template { body, .. } = &rule.body else {
+        let RuleBody::Template { body, effect } = &rule.body else {
             info.skipped = true;
             infos.push(info);
             step_nodes.push(None);
             continue;
         };
+        // A rule's `effect` is the step's effect, in every target: it takes
+        // the place of the PDDL action's (at start and at end), applied
+        // when the step succeeds.
+        if let Some(e) = effect {
+            let lifted = rule_effects.entry(ri).or_insert_with(|| RuleEffect::new(e));
+            match lifted.ground(&bindings) {
+                Ok(e) => {
+                    info.eff_start = None;
+                    info.eff_end = e;
+                }
+                Err(var) => {
+                    diags.push(
+                        Diagnostic::error(
+                            codes::R_EFFECT_UNBOUND,
+                            step.span,
+                            format!(
+                                "step {} `{}`: its rule's effect reads `?{var}`, which this step leaves out",
+                                k + 1,
+                                info.display()
+                            ),
+                        )
+                        .with_hint("an optional parameter the step does not give cannot stand in the rule's `effect`; write a rule for the shorter form"),
+                    );
+                }
+            }
+        }
         let pos = match rule_trees.iter().position(|(i, _)| *i == ri) {
             Some(p) => p,
             None => {
@@ -812,6 +652,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
                     used_nodes: BTreeSet::new(),
                     used_trees: BTreeSet::new(),
                     depth: 0,
+                    counts: Vec::new(),
                 };
                 let mut nodes = inst.templates(body, &|_| Vec::new());
                 let root = if nodes.len() == 1 {
@@ -827,6 +668,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
                         id,
                         params: inst.params.unwrap_or_default(),
                         typed: typed_ports(&root, input),
+                        counts: inst.counts,
                         root,
                     },
                 ));
@@ -843,6 +685,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
             used_nodes: BTreeSet::new(),
             used_trees: BTreeSet::new(),
             depth: 0,
+            counts: Vec::new(),
         };
         let ports: Vec<Port> = rt
             .params
@@ -852,6 +695,35 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
                 value: call_inst.eval(expr),
             })
             .collect();
+        // A decorator count that depends on the step must be a number in
+        // its range (a table may lack the key of this step's object).
+        for (param, d, range) in &rt.counts {
+            let Some(v) = ports.iter().find(|p| p.name == *param).map(|p| &p.value) else {
+                continue;
+            };
+            if count_in_range(v, *range).is_none() {
+                diags.push(
+                    Diagnostic::error(
+                        codes::R_BAD_ARGUMENT,
+                        step.span,
+                        format!(
+                            "step {} `{}`: `{}` gets {}, which is not a number of {} from {} to {}",
+                            k + 1,
+                            info.display(),
+                            d.keyword(),
+                            match v {
+                                PortValue::Text(t) if t.is_empty() => "no value".to_owned(),
+                                other => format!("`{}`", other.to_text()),
+                            },
+                            range.what,
+                            range.min,
+                            range.max
+                        ),
+                    )
+                    .with_hint("a table lookup gives no value for a key the table does not have; add the key"),
+                );
+            }
+        }
         // Objects bound to PDDL-typed ports must fit the port's type.
         check_port_types(
             &rt.typed,
@@ -878,16 +750,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
             child = Node::Control {
                 control: ControlKind::ReactiveSequence,
                 name: Some(format!("while {over}")),
-                children: vec![
-                    kb_leaf(
-                        LeafKind::Condition,
-                        "KbHolds",
-                        "formula",
-                        over.clone(),
-                        None,
-                    ),
-                    child,
-                ],
+                children: vec![kb_holds(over.clone(), None), child],
             };
         }
         step_nodes.push(Some(Node::Step {
@@ -904,7 +767,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
     let template = input.plan_template;
     let uses_parallel = template.is_some_and(|t| uses_mode(t, StepsMode::Parallel));
     if uses_parallel {
-        order_steps(input, &texts, &mut infos);
+        arrange::order_steps(&mut infos);
     }
     let mut used_kb = BTreeSet::new();
     // The plan template holds `steps` once (R022): the step nodes move into
@@ -918,11 +781,9 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
                 .into_iter()
                 .zip(&infos)
                 .filter_map(|(n, info)| n.map(|n| (n, info)))
-                .map(|(n, info)| {
-                    backchain(n, info, &texts[&input.steps[info.index].action], &info.args)
-                })
+                .map(|(n, info)| arrange::backchain(n, info))
                 .collect(),
-            StepsMode::Parallel => vec![parallel(&nodes, &infos)],
+            StepsMode::Parallel => vec![arrange::parallel(&nodes, &infos)],
         }
     };
     let root = match template {
@@ -936,6 +797,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
                 used_nodes: BTreeSet::new(),
                 used_trees: BTreeSet::new(),
                 depth: 0,
+                counts: Vec::new(),
             };
             let mut nodes = inst.templates(t, &arranged);
             used_nodes.extend(inst.used_nodes);
@@ -979,23 +841,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
         trees,
         nodes,
         steps: infos,
-        objects: input
-            .pix
-            .object_names
-            .iter()
-            .zip(&input.pix.object_types)
-            .map(|(n, t)| (n.clone(), input.dix.types.display(t)))
-            .collect(),
-        init: input
-            .problem
-            .init
-            .iter()
-            .filter_map(|f| match f {
-                btc_pddl::ast::InitFact::Atom { atom } => Some(atom.to_string()),
-                btc_pddl::ast::InitFact::Value { .. } => None,
-            })
-            .collect(),
-        goal: input.problem.goal.as_ref().map(|g| g.to_string()),
+        world: WorldModel::from_checked(input.domain, input.dix, input.problem, input.pix),
     })
 }
 
@@ -1031,7 +877,7 @@ fn typed_ports(root: &Node, input: &LowerInput) -> Vec<TypedPort> {
             let Some(pd) = decl.ports.iter().find(|d| d.name.text == p.name) else {
                 continue;
             };
-            let ty = pd.ty.text.to_lowercase();
+            let ty = pd.ty.key.clone().into_string();
             if crate::rules::check::BASIC_TYPES.contains(&ty.as_str())
                 || input.dix.types.id(&ty).is_none()
             {
@@ -1092,7 +938,7 @@ fn node_models(decls: &Decls, used: &BTreeSet<String>) -> Vec<NodeModel> {
                         ty: p.ty.text.clone(),
                     })
                     .collect(),
-                formula: n.formula.as_ref().map(|f| f.to_string()),
+                formula: n.formula.as_ref().map(Formula::from_ast),
             })
         })
         .collect()
@@ -1105,162 +951,4 @@ fn kb_decl(id: &str) -> Option<NodeDecl> {
         Item::Node(n) if n.name.text == id => Some(n),
         _ => None,
     })
-}
-
-/// `Fallback(effects already hold, Sequence(preconditions hold, step))`.
-fn backchain(step: Node, info: &StepInfo, t: &ActionTexts, args: &[String]) -> Node {
-    let Some(done) = t.done.as_ref().map(|d| d.ground(args)) else {
-        return step; // no plain effect to test: always run it
-    };
-    let mut seq = Vec::new();
-    if let Some(pre) = &info.pre_start {
-        seq.push(kb_leaf(
-            LeafKind::Condition,
-            "KbHolds",
-            "formula",
-            pre.clone(),
-            Some(format!("step {} ready?", info.index + 1)),
-        ));
-    }
-    seq.push(step);
-    Node::Control {
-        control: ControlKind::Fallback,
-        name: Some(format!("step {} {}", info.index + 1, info.display())),
-        children: vec![
-            kb_leaf(
-                LeafKind::Condition,
-                "KbHolds",
-                "formula",
-                done,
-                Some(format!("step {} done?", info.index + 1)),
-            ),
-            Node::Control {
-                control: ControlKind::Sequence,
-                name: None,
-                children: seq,
-            },
-        ],
-    }
-}
-
-/// Orders steps by causal links and threats: step j comes after step i
-/// (i < j) when i's effects touch j's conditions or effects, or j's effects
-/// touch i's conditions. Steps whose conditions or effects are not plain
-/// conjunctions are ordered after everything before them.
-fn order_steps(input: &LowerInput, texts: &BTreeMap<usize, ActionTexts>, infos: &mut [StepInfo]) {
-    type Lit = (bool, String, Vec<String>);
-    let ground = |lits: &[(bool, String, Vec<Slot>)], args: &[String]| -> Vec<Lit> {
-        lits.iter()
-            .map(|(p, pred, slots)| {
-                let a = slots
-                    .iter()
-                    .map(|s| match s {
-                        Slot::Param(i) => args[*i].clone(),
-                        Slot::Const(c) => c.clone(),
-                    })
-                    .collect();
-                (*p, pred.clone(), a)
-            })
-            .collect()
-    };
-    let per_step: Vec<Option<(Vec<Lit>, Vec<Lit>)>> = infos
-        .iter()
-        .map(|info| {
-            let t = &texts[&input.steps[info.index].action];
-            t.literals
-                .as_ref()
-                .map(|l| (ground(&l.pre, &info.args), ground(&l.eff, &info.args)))
-        })
-        .collect();
-    let touches = |a: &[Lit], b: &[Lit]| {
-        a.iter()
-            .any(|(_, p, x)| b.iter().any(|(_, q, y)| p == q && x == y))
-    };
-    for j in 0..infos.len() {
-        if infos[j].skipped {
-            continue;
-        }
-        let mut after = Vec::new();
-        for i in 0..j {
-            if infos[i].skipped {
-                continue;
-            }
-            let dep = match (&per_step[i], &per_step[j]) {
-                (Some((pi, ei)), Some((pj, ej))) => {
-                    touches(ei, pj) || touches(ei, ej) || touches(ej, pi)
-                }
-                _ => true,
-            };
-            if dep {
-                after.push(i);
-            }
-        }
-        infos[j].after = after;
-    }
-}
-
-/// Independent chains of steps under one Parallel node; a step that waits
-/// for a step of another chain starts with `WaitForStep`.
-fn parallel(step_nodes: &[Option<Node>], infos: &[StepInfo]) -> Node {
-    // Transitive "must precede" closure over the `after` lists.
-    let n = infos.len();
-    let mut precedes: Vec<BTreeSet<usize>> = vec![BTreeSet::new(); n];
-    for j in 0..n {
-        let mut set = BTreeSet::new();
-        for &i in &infos[j].after {
-            set.insert(i);
-            set.extend(precedes[i].iter().copied());
-        }
-        precedes[j] = set;
-    }
-    let mut chains: Vec<Vec<usize>> = Vec::new();
-    for j in (0..n).filter(|&j| step_nodes[j].is_some()) {
-        // Extend a chain whose last step must precede j anyway.
-        match chains
-            .iter_mut()
-            .find(|c| precedes[j].contains(c.last().expect("non-empty")))
-        {
-            Some(c) => c.push(j),
-            None => chains.push(vec![j]),
-        }
-    }
-    let branches: Vec<Node> = chains
-        .iter()
-        .map(|chain| {
-            let mut seq = Vec::new();
-            for (k, &j) in chain.iter().enumerate() {
-                let prev = if k > 0 { Some(chain[k - 1]) } else { None };
-                // Direct predecessors outside this chain (others are implied).
-                for &i in &infos[j].after {
-                    let implied = prev.is_some_and(|p| p == i || precedes[p].contains(&i));
-                    if !implied && !chain[..k].contains(&i) {
-                        seq.push(Node::Leaf {
-                            leaf: LeafKind::Action,
-                            id: "WaitForStep".into(),
-                            name: Some(format!("wait for step {}", i + 1)),
-                            ports: vec![Port {
-                                name: "step".into(),
-                                value: PortValue::Int(i as i64 + 1),
-                            }],
-                        });
-                    }
-                }
-                seq.push(step_nodes[j].clone().expect("filtered"));
-            }
-            Node::Control {
-                control: ControlKind::Sequence,
-                name: None,
-                children: seq,
-            }
-        })
-        .collect();
-    let count = branches.len().max(1) as u32;
-    Node::Control {
-        control: ControlKind::Parallel {
-            success: count,
-            failure: 1,
-        },
-        name: Some("plan".into()),
-        children: branches,
-    }
 }
