@@ -36,7 +36,7 @@ fn xml_ten_times_the_limit_is_refused_on_a_small_stack() {
 fn xml_at_the_limit_is_read_built_and_run_on_a_small_stack() {
     let status = on_small_stack(|| {
         // The root BehaviorTree takes a level.
-        let (doc, _) = load_tree(&nested_xml(MAX_DEPTH - 2)).expect("reads");
+        let doc = btc_runtime::xml::parse(&nested_xml(MAX_DEPTH - 2)).expect("reads");
         let mut e = Engine::build(&doc, None, Options::default()).expect("builds");
         e.run(10, |_| {})
     });
@@ -78,7 +78,7 @@ fn a_chain_of_subtrees_ten_times_the_limit_is_refused_on_a_small_stack() {
     ));
     let text = xml("T0", &trees);
     let r = on_small_stack(move || {
-        let (doc, _) = load_tree(&text).expect("each tree is shallow");
+        let doc = btc_runtime::xml::parse(&text).expect("each tree is shallow");
         Engine::build(&doc, None, Options::default()).map(|_| ())
     });
     assert_eq!(r.expect_err("too deep").code, codes::X_SUBTREE);
@@ -129,7 +129,7 @@ fn scenarios_ten_times_the_limit_are_refused_on_a_small_stack() {
 /// `--max-ticks 0` ticks nothing (it used to tick once).
 #[test]
 fn a_run_allowed_no_ticks_ticks_nothing() {
-    let (doc, _) = load_tree(&xml(
+    let doc = btc_runtime::xml::parse(&xml(
         "M",
         r#"<BehaviorTree ID="M"><AlwaysSuccess/></BehaviorTree>"#,
     ))
