@@ -128,10 +128,7 @@ pub fn parse_palette(text: &str, file: FileId) -> (Vec<ItemNode>, Vec<Diagnostic
                         (Some(kind), Some(id)) => {
                             let decl = NodeDecl {
                                 kind,
-                                name: Ident {
-                                    text: id.value.clone(),
-                                    span: id.span,
-                                },
+                                name: Ident::new(id.value.clone(), id.span),
                                 ports: Vec::new(),
                                 formula: None,
                                 span: id.span,
@@ -186,14 +183,8 @@ pub fn parse_palette(text: &str, file: FileId) -> (Vec<ItemNode>, Vec<Diagnostic
                                 if let Some(d) = current.as_mut() {
                                     d.ports.push(PortDecl {
                                         out,
-                                        name: Ident {
-                                            text: n.value.clone(),
-                                            span: n.span,
-                                        },
-                                        ty: Ident {
-                                            text: mapped.to_owned(),
-                                            span,
-                                        },
+                                        name: Ident::new(n.value.clone(), n.span),
+                                        ty: Ident::new(mapped.to_owned(), span),
                                         span: n.span,
                                     });
                                 }
