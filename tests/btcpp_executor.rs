@@ -97,35 +97,22 @@ fn rule_sets() -> Vec<RuleSet> {
             }],
         });
     }
-    if let Some(ipc) = btc_testkit::corpus() {
-        let mut dirs: Vec<PathBuf> = std::fs::read_dir(repo().join("tests/corpus_rules"))
-            .unwrap()
-            .map(|e| e.unwrap().path())
-            .collect();
-        dirs.sort();
-        for dir in dirs {
-            let name = dir.file_name().unwrap().to_string_lossy().into_owned();
-            let corpus = ipc.join(&name);
-            let mut plans: Vec<PathBuf> = std::fs::read_dir(&corpus)
-                .unwrap()
-                .map(|e| e.unwrap().path())
-                .filter(|p| p.extension().is_some_and(|e| e == "plan" || e == "tplan"))
-                .collect();
-            plans.sort();
-            sets.push(RuleSet {
-                name: name.clone(),
-                rules: dir.join("rules.btrules"),
-                jobs: plans
-                    .into_iter()
-                    .map(|p| Job {
-                        problem: corpus
-                            .join(format!("{}.pddl", p.file_stem().unwrap().to_string_lossy())),
-                        plan: p,
-                        ticks: vec![],
-                    })
-                    .collect(),
-            });
-        }
+    for d in btc_testkit::corpus_rules().unwrap_or_default() {
+        sets.push(RuleSet {
+            jobs: d
+                .plans
+                .into_iter()
+                .map(|p| Job {
+                    problem: d
+                        .corpus
+                        .join(format!("{}.pddl", p.file_stem().unwrap().to_string_lossy())),
+                    plan: p,
+                    ticks: vec![],
+                })
+                .collect(),
+            name: d.name,
+            rules: d.rules,
+        });
     }
     sets
 }

@@ -23,6 +23,26 @@ fn plan_of(example: &str) -> String {
     format!("examples/{example}/{}", plans[0])
 }
 
+/// `btc compile` of the ARIAC example to `out`, which must succeed.
+fn compile_ariac(emit: &str, out: &std::path::Path) {
+    let done = btc(&[
+        "compile",
+        "examples/ariac/rules.btrules",
+        "--plan",
+        "examples/ariac/plan.txt",
+        "--emit",
+        emit,
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        done.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&done.stderr)
+    );
+}
+
 fn summary(out: &Output) -> serde_json::Value {
     serde_json::from_slice(&out.stdout)
         .unwrap_or_else(|e| panic!("{e}: {}", String::from_utf8_lossy(&out.stdout)))
@@ -145,17 +165,7 @@ fn an_emitted_tree_runs_with_tree_and_the_problem() {
     let dir = tempfile::tempdir().unwrap();
     for (fmt, ext) in [("btcpp", "xml"), ("json", "json")] {
         let tree = dir.path().join(format!("tree.{ext}"));
-        let out = btc(&[
-            "compile",
-            "examples/ariac/rules.btrules",
-            "--plan",
-            "examples/ariac/plan.txt",
-            "--emit",
-            fmt,
-            "-o",
-            tree.to_str().unwrap(),
-        ]);
-        assert_eq!(out.status.code(), Some(0));
+        compile_ariac(fmt, &tree);
         let out = btc(&[
             "run",
             "--tree",
@@ -179,17 +189,7 @@ fn an_emitted_tree_runs_with_tree_and_the_problem() {
 fn a_kb_tree_without_a_problem_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let tree = dir.path().join("tree.xml");
-    let out = btc(&[
-        "compile",
-        "examples/ariac/rules.btrules",
-        "--plan",
-        "examples/ariac/plan.txt",
-        "--emit",
-        "btcpp",
-        "-o",
-        tree.to_str().unwrap(),
-    ]);
-    assert_eq!(out.status.code(), Some(0));
+    compile_ariac("btcpp", &tree);
     let out = btc(&["run", "--tree", tree.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("[X005]"));
@@ -254,17 +254,7 @@ fn a_tree_that_never_finishes_is_halted_after_max_ticks() {
 fn an_xml_tree_checks_step_preconditions_from_the_domain() {
     let dir = tempfile::tempdir().unwrap();
     let tree = dir.path().join("tree.xml");
-    let out = btc(&[
-        "compile",
-        "examples/ariac/rules.btrules",
-        "--plan",
-        "examples/ariac/plan.txt",
-        "--emit",
-        "btcpp",
-        "-o",
-        tree.to_str().unwrap(),
-    ]);
-    assert_eq!(out.status.code(), Some(0));
+    compile_ariac("btcpp", &tree);
     let out = btc(&[
         "run",
         "--tree",

@@ -181,18 +181,7 @@ pub fn experiment(ty: OrderType, sc: Scenario, seed: u64) -> Trial {
     let omit = (sc == Scenario::InsufficientParts).then(|| kinds[rng.usize(..kinds.len())]);
     let mut t = Trial {
         time_limit: Some(500.0),
-        trays: vec![
-            TrayOnTable {
-                tray_id: 1,
-                slot: 1,
-                range: R,
-            },
-            TrayOnTable {
-                tray_id: 2,
-                slot: 2,
-                range: R,
-            },
-        ],
+        trays: trays(&[(1, 1), (2, 2)]),
         bins: Vec::new(),
         agvs: Vec::new(),
         conveyor: None,
@@ -332,28 +321,7 @@ pub fn soak(seed: u64) -> Trial {
     let n_orders = rng.usize(1..=4);
     let mut t = Trial {
         time_limit: Some(400.0),
-        trays: vec![
-            TrayOnTable {
-                tray_id: 1,
-                slot: 1,
-                range: R,
-            },
-            TrayOnTable {
-                tray_id: 2,
-                slot: 2,
-                range: R,
-            },
-            TrayOnTable {
-                tray_id: 3,
-                slot: 4,
-                range: R,
-            },
-            TrayOnTable {
-                tray_id: 4,
-                slot: 5,
-                range: R,
-            },
-        ],
+        trays: trays(&[(1, 1), (2, 2), (3, 4), (4, 5)]),
         bins: Vec::new(),
         agvs: Vec::new(),
         conveyor: None,
@@ -549,4 +517,15 @@ pub fn soak(seed: u64) -> Trial {
         t.challenges.push(Challenge { kind, range: R });
     }
     t
+}
+
+/// Trays on the kit tray tables, as (tray id, slot) pairs.
+fn trays(at: &[(u8, u8)]) -> Vec<TrayOnTable> {
+    at.iter()
+        .map(|&(tray_id, slot)| TrayOnTable {
+            tray_id,
+            slot,
+            range: R,
+        })
+        .collect()
 }

@@ -5,40 +5,26 @@ use btc_emit::{emit, Format, Options};
 use btc_lang::db::{compile, rules_diagnostics, CompileJob, Database};
 use std::path::{Path, PathBuf};
 
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
 /// A rules file and its corpus plans, each with its problem.
 type Case = (PathBuf, Vec<(PathBuf, PathBuf)>);
 
 /// (rules path, [(problem path, plan path)]) per corpus domain with rules;
 /// `None` (the test skipped) without the corpus.
 pub fn cases() -> Option<Vec<Case>> {
-    let ipc = btc_testkit::corpus()?;
-    let mut out = Vec::new();
-    let mut dirs: Vec<PathBuf> = std::fs::read_dir(repo().join("tests/corpus_rules"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
+    let out: Vec<Case> = btc_testkit::corpus_rules()?
+        .into_iter()
+        .map(|d| {
+            let plans = d
+                .plans
+                .into_iter()
+                .map(|p| {
+                    let stem = p.file_stem().unwrap().to_string_lossy().into_owned();
+                    (d.corpus.join(format!("{stem}.pddl")), p)
+                })
+                .collect();
+            (d.rules, plans)
+        })
         .collect();
-    dirs.sort();
-    for dir in dirs {
-        let name = dir.file_name().unwrap().to_string_lossy().into_owned();
-        let corpus = ipc.join(&name);
-        let mut plans: Vec<(PathBuf, PathBuf)> = std::fs::read_dir(&corpus)
-            .unwrap()
-            .map(|e| e.unwrap().path())
-            .filter(|p| p.extension().is_some_and(|e| e == "plan" || e == "tplan"))
-            .map(|p| {
-                (
-                    corpus.join(format!("{}.pddl", p.file_stem().unwrap().to_string_lossy())),
-                    p,
-                )
-            })
-            .collect();
-        plans.sort();
-        out.push((dir.join("rules.btrules"), plans));
-    }
     assert!(out.len() >= 5, "rules for at least five corpus domains");
     Some(out)
 }

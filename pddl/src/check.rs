@@ -262,33 +262,25 @@ pub fn check_domain(domain: &Domain) -> (DomainIndex, Vec<Diagnostic>) {
     // Predicates and functions
     for (i, p) in domain.predicates.iter().enumerate() {
         let params = resolve_params(&p.params, &index.types, &mut diags, &mut used);
-        if let Some(prev) = index.predicates.get(p.name.as_str()) {
-            diags.push(duplicate("predicate", &p.name, prev.span));
-            continue;
-        }
-        index.predicates.insert(
-            p.name.name.clone(),
-            Signature {
-                index: i,
-                params,
-                span: p.name.span,
-            },
+        declare(
+            &mut index.predicates,
+            "predicate",
+            &p.name,
+            i,
+            params,
+            &mut diags,
         );
     }
     for (i, f) in domain.functions.iter().enumerate() {
         used.entry(Feature::Numeric).or_insert(f.name.span);
         let params = resolve_params(&f.params, &index.types, &mut diags, &mut used);
-        if let Some(prev) = index.functions.get(f.name.as_str()) {
-            diags.push(duplicate("function", &f.name, prev.span));
-            continue;
-        }
-        index.functions.insert(
-            f.name.name.clone(),
-            Signature {
-                index: i,
-                params,
-                span: f.name.span,
-            },
+        declare(
+            &mut index.functions,
+            "function",
+            &f.name,
+            i,
+            params,
+            &mut diags,
         );
     }
     for (i, a) in domain.actions.iter().enumerate() {
@@ -296,18 +288,7 @@ pub fn check_domain(domain: &Domain) -> (DomainIndex, Vec<Diagnostic>) {
         if a.durative {
             used.entry(Feature::Durative).or_insert(a.name.span);
         }
-        if let Some(prev) = index.actions.get(a.name.as_str()) {
-            diags.push(duplicate("action", &a.name, prev.span));
-            continue;
-        }
-        index.actions.insert(
-            a.name.name.clone(),
-            Signature {
-                index: i,
-                params,
-                span: a.name.span,
-            },
-        );
+        declare(&mut index.actions, "action", &a.name, i, params, &mut diags);
     }
     for d in &domain.derived {
         used.entry(Feature::Derived).or_insert(d.head.name.span);
@@ -563,6 +544,30 @@ fn check_duplicate_vars(params: &[Typed], diags: &mut Vec<Diagnostic>) {
             ));
         }
     }
+}
+
+/// Enters a predicate, function or action in its table; a second
+/// declaration of the name is an error pointing at the first.
+fn declare(
+    table: &mut FxHashMap<String, Signature>,
+    what: &str,
+    name: &Name,
+    index: usize,
+    params: Vec<Vec<TypeId>>,
+    diags: &mut Vec<Diagnostic>,
+) {
+    if let Some(prev) = table.get(name.as_str()) {
+        diags.push(duplicate(what, name, prev.span));
+        return;
+    }
+    table.insert(
+        name.name.clone(),
+        Signature {
+            index,
+            params,
+            span: name.span,
+        },
+    );
 }
 
 fn duplicate(what: &str, name: &Name, first: Span) -> Diagnostic {

@@ -385,6 +385,21 @@ impl Parser {
     }
 
     /// `a b - t c - (either u v) d` (names) or `?x ?y - t` (variables).
+    /// The variable list of a quantifier (`forall`, `exists`).
+    fn quantified_vars(&mut self, list: &Sexp) -> Option<Vec<Typed>> {
+        match list.as_list() {
+            Some(vl) => Some(self.typed_list(&vl.items, true)),
+            None => {
+                self.expected(
+                    "a variable list such as `(?x - t)`",
+                    Some(list),
+                    list.span(),
+                );
+                None
+            }
+        }
+    }
+
     fn typed_list(&mut self, items: &[Sexp], vars: bool) -> Vec<Typed> {
         let mut out: Vec<Typed> = Vec::new();
         let mut pending = 0usize; // trailing entries of `out` still waiting for a type
@@ -809,17 +824,7 @@ impl Parser {
                 if !arity(self, 2) {
                     return None;
                 }
-                let vars = match args[0].as_list() {
-                    Some(vl) => self.typed_list(&vl.items, true),
-                    None => {
-                        self.expected(
-                            "a variable list such as `(?x - t)`",
-                            Some(&args[0]),
-                            args[0].span(),
-                        );
-                        return None;
-                    }
-                };
+                let vars = self.quantified_vars(&args[0])?;
                 let body = Box::new(self.formula(&args[1])?);
                 if head == "exists" {
                     Formula::Exists { vars, body, span }
@@ -946,17 +951,7 @@ impl Parser {
                 if !count(self, 2) {
                     return None;
                 }
-                let vars = match args[0].as_list() {
-                    Some(vl) => self.typed_list(&vl.items, true),
-                    None => {
-                        self.expected(
-                            "a variable list such as `(?x - t)`",
-                            Some(&args[0]),
-                            args[0].span(),
-                        );
-                        return None;
-                    }
-                };
+                let vars = self.quantified_vars(&args[0])?;
                 Effect::Forall {
                     vars,
                     body: Box::new(self.effect(&args[1])?),

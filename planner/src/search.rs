@@ -257,14 +257,13 @@ impl<'t> Search<'t> {
             .sum()
     }
 
-    fn gbfs(&mut self, start: Instant) -> SearchResult {
-        let task = self.task;
-        let init = task.init.clone();
+    /// Registers the initial state as the search's first node: its id and
+    /// heuristic value, `None` when the heuristic finds it a dead end.
+    fn root(&mut self) -> Option<(u32, u64)> {
+        let init = self.task.init.clone();
         let (root, _) = self.reg.insert(&init);
         self.stats.evaluated += 1;
-        let Some(h0) = self.eval.eval(task, &init) else {
-            return SearchResult::Unsolvable;
-        };
+        let h0 = self.eval.eval(self.task, &init)?;
         self.nodes.push(Node {
             parent: u32::MAX,
             op: u32::MAX,
@@ -272,6 +271,14 @@ impl<'t> Search<'t> {
             h: h0,
             expanded_g: u64::MAX,
         });
+        Some((root, h0))
+    }
+
+    fn gbfs(&mut self, start: Instant) -> SearchResult {
+        let Some((root, h0)) = self.root() else {
+            return SearchResult::Unsolvable;
+        };
+        let task = self.task;
         let use_pref = self.opts.heuristic == Heuristic::Ff;
         // The preferred operators of each state, from its evaluation.
         let mut prefs: Vec<Box<[u32]>> = vec![self.eval.preferred.as_slice().into()];
@@ -354,20 +361,10 @@ impl<'t> Search<'t> {
     }
 
     fn astar(&mut self, start: Instant) -> SearchResult {
-        let task = self.task;
-        let init = task.init.clone();
-        let (root, _) = self.reg.insert(&init);
-        self.stats.evaluated += 1;
-        let Some(h0) = self.eval.eval(task, &init) else {
+        let Some((root, h0)) = self.root() else {
             return SearchResult::Unsolvable;
         };
-        self.nodes.push(Node {
-            parent: u32::MAX,
-            op: u32::MAX,
-            g: 0,
-            h: h0,
-            expanded_g: u64::MAX,
-        });
+        let task = self.task;
         // (f, h, g, id): lowest f, then lowest h.
         let mut open: BinaryHeap<Reverse<(u64, u64, u64, u32)>> = BinaryHeap::new();
         open.push(Reverse((h0, h0, 0, root)));

@@ -9,12 +9,11 @@
 
 mod common;
 use btc_ir::TreeIr;
-use btc_lang::db::{compile, CompileJob, Database, JobWorld};
+use btc_lang::db::{compile, JobWorld};
 use btc_pddl::logic::Formula;
 use btc_pddl::state::{Key, World};
 use btc_runtime::{Engine, Kb, Status, TreeDoc};
-use common::{root, traced};
-use std::path::{Path, PathBuf};
+use common::{corpus_job, traced};
 
 /// The rules text with its `plan { ... }` block (if any) replaced by
 /// `plan { steps backchained }`.
@@ -93,46 +92,19 @@ fn needed(kb: &Kb, ir: &TreeIr, later: &[usize]) -> Vec<(String, Key)> {
 
 #[test]
 fn backchained_plans_resume_from_every_prefix_and_redo_what_a_lost_fact_needs() {
-    let Some(ipc) = btc_testkit::corpus() else {
+    let Some(domains) = btc_testkit::corpus_rules() else {
         return;
     };
-    let root = root();
-    let mut dirs: Vec<PathBuf> = std::fs::read_dir(root.join("tests/corpus_rules"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .collect();
-    dirs.sort();
     let (mut prefixes, mut deletions, mut redone, mut failed) = (0, 0, 0, 0);
-    for dir in dirs {
-        let name = dir.file_name().unwrap().to_string_lossy().into_owned();
-        let rules_path = dir.join("rules.btrules");
-        let rules_text = backchained(&std::fs::read_to_string(&rules_path).unwrap());
-        let written = rules_text
-            .lines()
-            .find_map(|l| l.strip_prefix("domain \""))
-            .unwrap()
-            .trim_end_matches('"')
-            .to_owned();
-        let corpus = ipc.join(&name);
-        let mut plans: Vec<PathBuf> = std::fs::read_dir(&corpus)
-            .unwrap()
-            .map(|e| e.unwrap().path())
+    for d in domains {
+        let rules_text = backchained(&std::fs::read_to_string(&d.rules).unwrap());
+        // Timed plans (`.tplan`) run in parallel, not backchained.
+        for plan in d
+            .plans
+            .iter()
             .filter(|p| p.extension().is_some_and(|e| e == "plan"))
-            .collect();
-        plans.sort();
-        for plan in plans {
-            let mut db = Database::new();
-            let key = |p: &Path| btc_lang::db::normalize(p);
-            db.set_file(
-                &key(&dir.join(&written)),
-                std::fs::read_to_string(dir.join(&written)).unwrap(),
-            );
-            let r = db.set_file(&key(&rules_path), rules_text.clone());
-            let stem = plan.file_stem().unwrap().to_string_lossy().into_owned();
-            let problem = corpus.join(format!("{stem}.pddl"));
-            let p = db.set_file(&key(&problem), std::fs::read_to_string(&problem).unwrap());
-            let l = db.set_file(&key(&plan), std::fs::read_to_string(&plan).unwrap());
-            let job = CompileJob::new(&db, r, l, Some(p), None);
+        {
+            let (db, job) = corpus_job(&d.rules, &rules_text, plan);
             let what = plan.display().to_string();
             let ir = compile(&db, job)
                 .clone()

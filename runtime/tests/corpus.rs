@@ -3,53 +3,21 @@
 //! from the IR and from the BT.CPP XML written for it, with the same trace.
 
 mod common;
+use btc_lang::db::compile;
 use btc_lang::db::JobWorld;
-use btc_lang::db::{compile, CompileJob, Database};
 use btc_runtime::{xml, Engine, Status, TreeDoc};
-use common::{root, traced};
-use std::path::{Path, PathBuf};
+use common::{corpus_job, traced};
 
 #[test]
 fn corpus_plans_run_to_their_goal() {
-    let Some(ipc) = btc_testkit::corpus() else {
+    let Some(domains) = btc_testkit::corpus_rules() else {
         return;
     };
-    let root = root();
-    let mut dirs: Vec<PathBuf> = std::fs::read_dir(root.join("tests/corpus_rules"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .collect();
-    dirs.sort();
     let mut ran = 0;
-    for dir in dirs {
-        let name = dir.file_name().unwrap().to_string_lossy().into_owned();
-        let rules_path = dir.join("rules.btrules");
-        let rules_text = std::fs::read_to_string(&rules_path).unwrap();
-        let written = rules_text
-            .lines()
-            .find_map(|l| l.strip_prefix("domain \""))
-            .unwrap()
-            .trim_end_matches('"');
-        let corpus = ipc.join(&name);
-        let mut plans: Vec<PathBuf> = std::fs::read_dir(&corpus)
-            .unwrap()
-            .map(|e| e.unwrap().path())
-            .filter(|p| p.extension().is_some_and(|e| e == "plan" || e == "tplan"))
-            .collect();
-        plans.sort();
-        for plan in plans {
-            let mut db = Database::new();
-            let key = |p: &Path| btc_lang::db::normalize(p);
-            db.set_file(
-                &key(&dir.join(written)),
-                std::fs::read_to_string(dir.join(written)).unwrap(),
-            );
-            let r = db.set_file(&key(&rules_path), rules_text.clone());
-            let stem = plan.file_stem().unwrap().to_string_lossy().into_owned();
-            let problem = corpus.join(format!("{stem}.pddl"));
-            let p = db.set_file(&key(&problem), std::fs::read_to_string(&problem).unwrap());
-            let l = db.set_file(&key(&plan), std::fs::read_to_string(&plan).unwrap());
-            let job = CompileJob::new(&db, r, l, Some(p), None);
+    for d in domains {
+        let rules_text = std::fs::read_to_string(&d.rules).unwrap();
+        for plan in d.plans {
+            let (db, job) = corpus_job(&d.rules, &rules_text, &plan);
             let ir = compile(&db, job)
                 .clone()
                 .unwrap_or_else(|e| panic!("{}: {e:#?}", plan.display()));

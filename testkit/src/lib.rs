@@ -69,6 +69,52 @@ pub fn corpus() -> Option<PathBuf> {
     }
 }
 
+/// A corpus domain with rules in `tests/corpus_rules/<name>/`.
+pub struct RulesDomain {
+    pub name: String,
+    /// `tests/corpus_rules/<name>/rules.btrules`.
+    pub rules: PathBuf,
+    /// The domain's folder in the corpus.
+    pub corpus: PathBuf,
+    /// Its plans (`.plan`, `.tplan`), sorted; each `pXX` pairs with the
+    /// problem `pXX.pddl` beside it.
+    pub plans: Vec<PathBuf>,
+}
+
+/// Every corpus domain the repository has rules for, by name, or `None`
+/// after [`skip`] without the corpus.
+pub fn corpus_rules() -> Option<Vec<RulesDomain>> {
+    let ipc = corpus()?;
+    let sorted = |dir: &Path, keep: &dyn Fn(&Path) -> bool| -> Vec<PathBuf> {
+        let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
+            .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+            .map(|e| e.unwrap().path())
+            .filter(|p| keep(p))
+            .collect();
+        v.sort();
+        v
+    };
+    let domains = sorted(&repo().join("tests/corpus_rules"), &|p| p.is_dir());
+    Some(
+        domains
+            .into_iter()
+            .map(|dir| {
+                let name = dir.file_name().unwrap().to_string_lossy().into_owned();
+                let corpus = ipc.join(&name);
+                let plans = sorted(&corpus, &|p| {
+                    p.extension().is_some_and(|e| e == "plan" || e == "tplan")
+                });
+                RulesDomain {
+                    rules: dir.join("rules.btrules"),
+                    name,
+                    corpus,
+                    plans,
+                }
+            })
+            .collect(),
+    )
+}
+
 /// Where the IPC corpus is looked for (`BTC_CORPUS`, or
 /// `../shared/corpus/ipc` beside the repository), whether or not it is there.
 pub fn corpus_path() -> PathBuf {

@@ -191,6 +191,20 @@ impl Reader {
         );
     }
 
+    /// A tray quadrant (1 to 4) and where it is written.
+    fn quadrant(&mut self, f: &mut Fields<'_>) -> Option<(u8, Range)> {
+        let n = self.need(f, "quadrant")?;
+        self.int(n, "a quadrant", 1, 4).map(|q| (q as u8, n.range))
+    }
+
+    /// Reports a quadrant given twice (`taken`); says whether it was.
+    fn taken(&mut self, taken: bool, r: Range, msg: impl FnOnce() -> String) -> bool {
+        if taken {
+            self.error(codes::TRIAL_DUPLICATE, r, msg());
+        }
+        taken
+    }
+
     fn int(&mut self, node: &Node, what: &str, lo: i64, hi: i64) -> Option<i64> {
         match node.scalar() {
             Some(ScalarKind::Int(n)) if (lo..=hi).contains(&n) => Some(n),
@@ -610,9 +624,7 @@ impl Reader {
                         continue;
                     };
                     let kind = self.kind(&mut pf);
-                    let q = self
-                        .need(&mut pf, "quadrant")
-                        .and_then(|n| self.int(n, "a quadrant", 1, 4).map(|q| (q as u8, n.range)));
+                    let q = self.quadrant(&mut pf);
                     if let Some(r) = pf.get("rotation") {
                         self.rotation(r);
                     }
@@ -624,12 +636,9 @@ impl Reader {
                     let (Some(kind), Some((quadrant, qr))) = (kind, q) else {
                         continue;
                     };
-                    if parts.iter().any(|x| x.quadrant == quadrant) {
-                        self.error(
-                            codes::TRIAL_DUPLICATE,
-                            qr,
-                            format!("quadrant {quadrant} of `{name}` holds a part already"),
-                        );
+                    if self.taken(parts.iter().any(|x| x.quadrant == quadrant), qr, || {
+                        format!("quadrant {quadrant} of `{name}` holds a part already")
+                    }) {
                         continue;
                     }
                     parts.push(AgvPart {
@@ -1188,19 +1197,14 @@ impl Reader {
                     continue;
                 };
                 let kind = self.kind(&mut pf);
-                let q = self
-                    .need(&mut pf, "quadrant")
-                    .and_then(|n| self.int(n, "a quadrant", 1, 4).map(|q| (q as u8, n.range)));
+                let q = self.quadrant(&mut pf);
                 self.done(pf, &["type", "color", "quadrant"]);
                 let (Some(kind), Some((quadrant, qr))) = (kind, q) else {
                     continue;
                 };
-                if products.iter().any(|x| x.quadrant == quadrant) {
-                    self.error(
-                        codes::TRIAL_DUPLICATE,
-                        qr,
-                        format!("quadrant {quadrant} is asked for twice in this kit"),
-                    );
+                if self.taken(products.iter().any(|x| x.quadrant == quadrant), qr, || {
+                    format!("quadrant {quadrant} is asked for twice in this kit")
+                }) {
                     continue;
                 }
                 products.push(KitProduct {

@@ -509,6 +509,31 @@ fn kw<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
     just(Tok::Ident(word.to_owned())).ignored().labelled(word)
 }
 
+/// Templates in braces; a block that does not parse becomes one error
+/// node and parsing goes on after its closing brace.
+fn block_of<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
+    template: impl Parser<'t, I, Template, Err<'t>> + Clone,
+    file: FileId,
+) -> impl Parser<'t, I, Vec<Template>, Err<'t>> + Clone {
+    template
+        .repeated()
+        .collect::<Vec<Template>>()
+        .delimited_by(punct("{"), punct("}"))
+        .recover_with(via_parser(nested_delimiters(
+            Tok::Punct("{"),
+            Tok::Punct("}"),
+            [
+                (Tok::Punct("("), Tok::Punct(")")),
+                (Tok::Punct("["), Tok::Punct("]")),
+            ],
+            move |s: SimpleSpan| {
+                vec![Template::Error {
+                    span: Span::new(file, s.start, s.end),
+                }]
+            },
+        )))
+}
+
 fn punct<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
     p: &'static str,
 ) -> impl Parser<'t, I, (), Err<'t>> + Clone {
@@ -618,20 +643,7 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
         .labelled("a port list such as `(robot: robot)`");
 
     let template = recursive(|template| {
-        let block = template
-            .clone()
-            .repeated()
-            .collect::<Vec<Template>>()
-            .delimited_by(punct("{"), punct("}"))
-            .recover_with(via_parser(nested_delimiters(
-                Tok::Punct("{"),
-                Tok::Punct("}"),
-                [
-                    (Tok::Punct("("), Tok::Punct(")")),
-                    (Tok::Punct("["), Tok::Punct("]")),
-                ],
-                move |s| vec![Template::Error { span: sp(s) }],
-            )));
+        let block = block_of(template.clone(), file);
         let parallel_args = kw("success")
             .ignore_then(punct(":"))
             .ignore_then(count)
@@ -727,20 +739,7 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
             .labelled("a node, a control such as `sequence`, or a decorator")
     });
 
-    let body_block = template
-        .clone()
-        .repeated()
-        .collect::<Vec<_>>()
-        .delimited_by(punct("{"), punct("}"))
-        .recover_with(via_parser(nested_delimiters(
-            Tok::Punct("{"),
-            Tok::Punct("}"),
-            [
-                (Tok::Punct("("), Tok::Punct(")")),
-                (Tok::Punct("["), Tok::Punct("]")),
-            ],
-            move |s| vec![Template::Error { span: sp(s) }],
-        )));
+    let body_block = block_of(template.clone(), file);
 
     let formula = select! { Tok::Formula(f) => Some(*f), Tok::BadPddl => None }
         .labelled("a PDDL formula in parentheses");

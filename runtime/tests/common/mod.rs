@@ -20,6 +20,29 @@ pub fn fixture(name: &str) -> String {
     std::fs::read_to_string(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
 }
 
+/// A corpus plan set up for compiling: the rules (given as text, which
+/// may differ from the file's), the domain their `domain` line names, the
+/// plan and the problem of the plan's stem beside it.
+pub fn corpus_job(rules: &Path, rules_text: &str, plan: &Path) -> (Database, CompileJob) {
+    let mut db = Database::new();
+    let key = |p: &Path| db::normalize(p);
+    let dir = rules.parent().unwrap();
+    let written = rules_text
+        .lines()
+        .find_map(|l| l.strip_prefix("domain \""))
+        .unwrap()
+        .trim_end_matches('"');
+    let domain = dir.join(written);
+    db.set_file(&key(&domain), std::fs::read_to_string(&domain).unwrap());
+    let r = db.set_file(&key(rules), rules_text.to_owned());
+    let stem = plan.file_stem().unwrap().to_string_lossy().into_owned();
+    let problem = plan.with_file_name(format!("{stem}.pddl"));
+    let p = db.set_file(&key(&problem), std::fs::read_to_string(&problem).unwrap());
+    let l = db.set_file(&key(plan), std::fs::read_to_string(plan).unwrap());
+    let job = CompileJob::new(&db, r, l, Some(p), None);
+    (db, job)
+}
+
 pub const EXAMPLES: &[&str] = &["ariac", "nist_kitting", "p3_assembler", "two_robots"];
 
 /// An example folder loaded and compiled (rules, its first plan, problem).
