@@ -232,6 +232,16 @@ pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
                 ir.steps.len(),
                 ir.steps.len() - steps
             );
+            // An imported runtime goes beside the module, where its import
+            // finds it; it is btc's file and always rewritten.
+            if a.emit == emit::Format::Pytrees
+                && a.options.runtime == emit::pytrees::Runtime::Import
+            {
+                let dir = out.parent().unwrap_or(Path::new(""));
+                let rt = dir.join(format!("{}.py", emit::pytrees::RUNTIME_MODULE));
+                files::write_atomically(&rt, emit::pytrees::RUNTIME)?;
+                eprintln!("wrote {}", rt.display());
+            }
         }
         None => print!("{text}"),
     }

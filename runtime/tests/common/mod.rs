@@ -59,6 +59,39 @@ pub fn example(name: &str) -> Example {
     Example { db, job, ir }
 }
 
+/// Compiles `rules` with `plan` and `problem`; every file of the rules'
+/// folder and the domain the rules file names are loaded.
+pub fn load(rules: &Path, plan: &Path, problem: &Path) -> Example {
+    let mut db = Database::new();
+    let dir = rules.parent().unwrap();
+    let text = std::fs::read_to_string(rules).unwrap();
+    let extra: Vec<PathBuf> = text
+        .lines()
+        .find_map(|l| l.trim().strip_prefix("domain \""))
+        .map(|d| dir.join(d.trim_end_matches('"')))
+        .into_iter()
+        .collect();
+    let mut names: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.is_file())
+        .collect();
+    names.extend(extra);
+    names.extend([plan.to_path_buf(), problem.to_path_buf()]);
+    names.sort();
+    names.dedup();
+    for p in &names {
+        db.set_file(&db::normalize(p), std::fs::read_to_string(p).unwrap());
+    }
+    let file = |p: &Path| db.file(&db::normalize(p)).unwrap();
+    let job = CompileJob::new(&db, file(rules), file(plan), Some(file(problem)), None);
+    let ir = db::compile(&db, job)
+        .as_ref()
+        .unwrap_or_else(|e| panic!("{}: {e:#?}", rules.display()))
+        .clone();
+    Example { db, job, ir }
+}
+
 impl Example {
     pub fn job_world(&self) -> JobWorld<'_> {
         JobWorld::of(&self.db, self.job).expect("the example has a domain and a problem")
