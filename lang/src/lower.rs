@@ -20,7 +20,7 @@ use std::collections::{BTreeMap, BTreeSet};
 mod action;
 mod arrange;
 
-use action::ActionLogic;
+use action::{ActionLogic, RuleEffect};
 use arrange::kb_holds;
 
 pub struct LowerInput<'a> {
@@ -446,6 +446,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
     };
     let tables = |name: &str| input.decls.tables.get(name).cloned();
     let mut actions: BTreeMap<usize, ActionLogic> = BTreeMap::new();
+    let mut rule_effects: BTreeMap<usize, RuleEffect> = BTreeMap::new();
     let mut rule_trees: Vec<(usize, RuleTree)> = Vec::new(); // by rule index
     let mut taken = BTreeSet::new();
     let mut used_nodes = BTreeSet::new();
@@ -534,12 +535,38 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
             step_nodes.push(None);
             continue;
         };
-        let RuleBody::Template { body, .. } = &rule.body else {
+        let RuleBody::Template { body, effect } = &rule.body else {
             info.skipped = true;
             infos.push(info);
             step_nodes.push(None);
             continue;
         };
+        // A rule's `effect` is the step's effect, in every target: it takes
+        // the place of the PDDL action's (at start and at end), applied
+        // when the step succeeds.
+        if let Some(e) = effect {
+            let lifted = rule_effects.entry(ri).or_insert_with(|| RuleEffect::new(e));
+            match lifted.ground(&bindings) {
+                Ok(e) => {
+                    info.eff_start = None;
+                    info.eff_end = e;
+                }
+                Err(var) => {
+                    diags.push(
+                        Diagnostic::error(
+                            codes::R_EFFECT_UNBOUND,
+                            step.span,
+                            format!(
+                                "step {} `{}`: its rule's effect reads `?{var}`, which this step leaves out",
+                                k + 1,
+                                info.display()
+                            ),
+                        )
+                        .with_hint("an optional parameter the step does not give cannot stand in the rule's `effect`; write a rule for the shorter form"),
+                    );
+                }
+            }
+        }
         let pos = match rule_trees.iter().position(|(i, _)| *i == ri) {
             Some(p) => p,
             None => {

@@ -320,6 +320,7 @@ pub mod codes {
         R_UNKNOWN_TYPE = "R021", "a port type that is neither a PDDL type nor a basic type";
         R_PLAN_BLOCK = "R022", "a `plan` block that is missing, repeated or has no `steps`";
         R_BAD_ARGUMENT = "R023", "a control or decorator argument that makes no sense";
+        R_EFFECT_UNBOUND = "R033", "a rule effect that reads an optional parameter a step leaves out";
         R_TOO_DEEP = "R060", "a template nested deeper than btc supports";
         // Running trees (btc run)
         X_TREE_SYNTAX = "X001", "a behavior tree file that is not BT.CPP v4 XML or btc's JSON IR";

@@ -1002,51 +1002,23 @@ fn show_literal((positive, pred, args): &(bool, String, Vec<String>), r: &Rule) 
     }
 }
 
-/// The PDDL action's effect with its parameters renamed to the rule's variables.
+/// The PDDL action's effect with its parameters renamed to the rule's
+/// variables (by the fold: all at once, so swaps work, and quantified
+/// variables are renamed out of the way).
 pub fn rewrite_effect(effects: &[&Effect], action: &btc_pddl::ast::Action, r: &Rule) -> String {
-    let text = match effects {
-        [one] => one.to_string(),
-        many => format!(
-            "(and {})",
-            many.iter()
-                .map(|e| e.to_string())
-                .collect::<Vec<_>>()
-                .join(" ")
-        ),
+    use btc_pddl::logic::{self, Renaming, Terms};
+    let parts: Vec<logic::Effect> = effects.iter().map(|e| logic::Effect::from_ast(e)).collect();
+    let effect = match <[logic::Effect; 1]>::try_from(parts) {
+        Ok([one]) => one,
+        Err(many) => logic::Effect::And(many),
     };
-    // Rename through placeholders so `?a`->`?b`, `?b`->`?a` swaps work.
-    let mut out = text;
-    let mut renames = Vec::new();
-    for (i, p) in action.params.iter().enumerate() {
-        if let Some(rp) = r.pattern.params.get(i) {
-            renames.push((
-                format!("?{}", p.name.name),
-                format!("\u{0}{i}\u{0}"),
-                format!("?{}", rp.var.text),
-            ));
-        }
-    }
-    for (from, mid, _) in &renames {
-        out = replace_var(&out, from, mid);
-    }
-    for (_, mid, to) in &renames {
-        out = out.replace(mid.as_str(), to);
-    }
-    out
-}
-
-fn replace_var(text: &str, var: &str, with: &str) -> String {
-    let mut out = String::new();
-    let mut rest = text;
-    while let Some(i) = rest.find(var) {
-        let after = rest[i + var.len()..].chars().next();
-        let whole = !after.is_some_and(|c| c.is_alphanumeric() || c == '_' || c == '-');
-        out.push_str(&rest[..i]);
-        out.push_str(if whole { with } else { var });
-        rest = &rest[i + var.len()..];
-    }
-    out.push_str(rest);
-    out
+    let pairs: Vec<(logic::Name, logic::Name)> = action
+        .params
+        .iter()
+        .zip(&r.pattern.params)
+        .map(|(p, rp)| (logic::name(&p.name.name), logic::name(&rp.var.text)))
+        .collect();
+    effect.rename(&Renaming { pairs: &pairs }).to_string()
 }
 
 /// File-level checks; spans absolute. `items` are this file's items.
