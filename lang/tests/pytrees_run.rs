@@ -201,8 +201,8 @@ fn fixtures_run_to_success() {
         "(\"D\", \"force_failure\", ",
         "(\"f\", ",
         "(\"F\", ",
-        "KbHolds,",
-        "WaitForStep,",
+        "(\"KbHolds\", KbHolds)",
+        "(\"WaitForStep\", WaitForStep)",
     ] {
         assert!(all.contains(construct), "no job emits {construct}");
     }

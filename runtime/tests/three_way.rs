@@ -1,6 +1,7 @@
 //! One meaning in every executor: each job (every example, every corpus
 //! plan of a domain with rules, every rules fixture of the py_trees and
-//! parallel folders) runs three ways — the IR in btc's engine, the emitted
+//! parallel folders, the feature fixtures of `fixtures/three_way/` and the
+//! rule-effect fixture) runs three ways — the IR in btc's engine, the emitted
 //! BT.CPP XML in btc's engine (SubTree mode and `--inline`), and the emitted
 //! py_trees module under real py_trees — and all give the same step starts
 //! and ends (with their ticks), the same final KB, the same status and the
@@ -170,7 +171,8 @@ fn rules_fixtures_mean_the_same_in_every_executor() {
         let dir = root().join("lang/tests/fixtures").join(folder);
         for (rules, ex) in folder_jobs(&dir) {
             let name = format!("{}_{}", folder.replace('/', "_"), rules.replace('.', "_"));
-            three_ways(&ex, &name);
+            let o = three_ways(&ex, &name);
+            assert!(o.status == "SUCCESS" && o.goal_reached, "{name}: {o:?}");
             ran += 1;
         }
     }
@@ -181,6 +183,9 @@ fn rules_fixtures_mean_the_same_in_every_executor() {
         .filter(|p| p.is_dir())
         .collect();
     folders.sort();
+    // A rule whose effect differs from the PDDL action's: all three show
+    // the rule's effect in the final KB.
+    folders.push(root().join("runtime/tests/fixtures/rule_effect"));
     for f in folders {
         for (rules, ex) in folder_jobs(&f) {
             let name = format!(
@@ -188,11 +193,12 @@ fn rules_fixtures_mean_the_same_in_every_executor() {
                 f.file_name().unwrap().to_string_lossy(),
                 rules.replace('.', "_")
             );
-            three_ways(&ex, &name);
+            let o = three_ways(&ex, &name);
+            assert!(o.status == "SUCCESS" && o.goal_reached, "{name}: {o:?}");
             ran += 1;
         }
     }
-    assert!(ran >= 5, "only {ran} fixtures ran");
+    assert!(ran >= 8, "only {ran} fixtures ran");
 }
 
 #[test]

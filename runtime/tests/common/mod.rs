@@ -36,32 +36,21 @@ pub fn example(name: &str) -> Example {
 /// A folder with `rules.btrules`, `problem.pddl`, a domain and a `plan.*`,
 /// compiled (`name` for messages).
 pub fn compile_dir(dir: &Path, name: &str) -> Example {
-    let mut db = Database::new();
-    let mut rules = None;
-    let mut plan = None;
-    let mut names: Vec<PathBuf> = std::fs::read_dir(dir)
+    let mut plans: Vec<PathBuf> = std::fs::read_dir(dir)
         .unwrap()
         .map(|e| e.unwrap().path())
-        .filter(|p| p.is_file())
+        .filter(|p| {
+            p.file_name()
+                .unwrap()
+                .to_string_lossy()
+                .starts_with("plan.")
+        })
         .collect();
-    names.sort();
-    for p in names {
-        let name = p.file_name().unwrap().to_string_lossy().into_owned();
-        let f = db.set_file(&db::normalize(&p), std::fs::read_to_string(&p).unwrap());
-        if name.starts_with("plan.") && plan.is_none() {
-            plan = Some(f);
-        }
-        if name == "rules.btrules" {
-            rules = Some(f);
-        }
-    }
-    let problem = db.file(&db::normalize(&dir.join("problem.pddl")));
-    let job = CompileJob::new(&db, rules.unwrap(), plan.unwrap(), problem, None);
-    let ir = db::compile(&db, job)
-        .as_ref()
-        .unwrap_or_else(|e| panic!("{name}: {e:#?}"))
-        .clone();
-    Example { db, job, ir }
+    plans.sort();
+    let plan = plans
+        .first()
+        .unwrap_or_else(|| panic!("{name}: no plan.* file"));
+    load(&dir.join("rules.btrules"), plan, &dir.join("problem.pddl"))
 }
 
 /// Compiles `rules` with `plan` and `problem`; every file of the rules'
