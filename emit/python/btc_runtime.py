@@ -976,6 +976,13 @@ class _Builder:
             return cls(name, **ports)
         if kind == "D":
             _, dkind, arg, name, child = spec
+            arg = self.value(arg, args)
+            if not isinstance(arg, int):
+                # A count the call gives as a port value.
+                try:
+                    arg = int(value_text(arg).strip())
+                except ValueError:
+                    return Unresolved(name="%s: `%s` is not a number" % (dkind, value_text(arg)))
             name = self.name(name, args) or _decorator_name(dkind, arg)
             if dkind == "retry" and arg == 0:
                 return py_trees.behaviours.Failure(name=name)

@@ -17,7 +17,7 @@
 mod encode;
 pub mod names;
 
-use btc_ir::{ControlKind, DecoratorKind};
+use btc_ir::{ControlKind, Count, DecoratorKind};
 use btc_ir::{LeafKind, Node, NodeModel, Port, StepInfo, TreeIr};
 use btc_pddl::logic::InitFact;
 use names::{is_plain_kwarg, RESERVED};
@@ -433,13 +433,20 @@ impl<'a> Emitter<'a> {
                 name,
                 child,
             } => {
-                let (kind, arg) = match *decorator {
-                    DecoratorKind::Retry { times } => ("retry", times as u64),
-                    DecoratorKind::Repeat { times } => ("repeat", times as u64),
-                    DecoratorKind::Timeout { ms } => ("timeout", ms),
-                    DecoratorKind::Inverter => ("inverter", 0),
-                    DecoratorKind::ForceSuccess => ("force_success", 0),
-                    DecoratorKind::ForceFailure => ("force_failure", 0),
+                let (kind, count) = match decorator {
+                    DecoratorKind::Retry { times } => ("retry", Some(times)),
+                    DecoratorKind::Repeat { times } => ("repeat", Some(times)),
+                    DecoratorKind::Timeout { ms } => ("timeout", Some(ms)),
+                    DecoratorKind::Inverter => ("inverter", None),
+                    DecoratorKind::ForceSuccess => ("force_success", None),
+                    DecoratorKind::ForceFailure => ("force_failure", None),
+                };
+                // A count from the call is a parameter, filled in when the
+                // tree is built.
+                let arg = match count {
+                    Some(Count::Fixed(n)) => n.to_string(),
+                    Some(Count::Param { param }) => format!("(\"$\", {})", py_str(param)),
+                    None => "0".into(),
                 };
                 let _ = write!(o, "(\"D\", \"{kind}\", {arg}, {}, ", opt_name(name));
                 self.node(child, o, indent);
