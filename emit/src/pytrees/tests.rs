@@ -1,6 +1,5 @@
 use super::names::*;
 use super::*;
-use btc_ir::{Port, PortValue};
 
 #[test]
 fn strings_are_escaped() {
@@ -88,7 +87,7 @@ fn module_names_are_imported_safely() {
         ("my_nodes".into(), "import my_nodes\n".into())
     );
     assert_eq!(module_import("pkg.nodes").0, "pkg.nodes");
-    for clash in ["sys", "KB", "py_trees.x", "_warn", "main"] {
+    for clash in ["sys", "WORLD", "py_trees.x", "_reset", "main"] {
         assert_eq!(module_import(clash).0, "NODE_MODULE", "{clash}");
     }
     let (prefix, import) = module_import("my-nodes\"\nimport os");
