@@ -9,3 +9,4 @@
 pub mod db;
 pub mod lower;
 pub mod rules;
+pub mod targets;

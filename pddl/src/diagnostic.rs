@@ -329,6 +329,8 @@ pub mod codes {
         R_GUARD_OBJECT = "R043", "a guard comparing a variable with an object that can never stand there";
         R_SKIP_CHANGES = "R044", "a `=> skip` rule for steps whose effects change the world";
         R_TOO_DEEP = "R060", "a template nested deeper than btc supports";
+        // Emitting (btc compile --emit): what a target cannot express
+        E_PYTREES_NODE = "E001", "a node a py_trees module cannot run as btc's engine does";
         // Running trees (btc run)
         X_TREE_SYNTAX = "X001", "a behavior tree file that is not BT.CPP v4 XML or btc's JSON IR";
         X_UNKNOWN_NODE = "X002", "a tree node that is neither built in nor declared";

@@ -74,6 +74,10 @@ impl Encoder<'_> {
             self.out.push_str(", ");
             each(self, p);
         }
+        // `(":and",)`: without the comma Python reads a string, not a tuple.
+        if parts.is_empty() {
+            self.out.push(',');
+        }
         self.out.push(')');
     }
 

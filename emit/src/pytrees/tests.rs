@@ -116,3 +116,11 @@ fn the_runtime_names_are_reserved() {
     }
     assert!(missing.is_empty(), "not in RESERVED: {missing:?}");
 }
+
+#[test]
+fn empty_conjunctions_are_tuples() {
+    use btc_pddl::logic::Formula;
+    // `(and)`, the empty precondition: `(":and")` would be a Python string.
+    assert_eq!(encode::formula(&Formula::And(Vec::new())), "(\":and\",)");
+    assert_eq!(encode::formula(&Formula::Or(Vec::new())), "(\":or\",)");
+}
