@@ -1,6 +1,6 @@
 """A seed-style P3 generator: the algorithm of the "P3 assembler" pseudocode
 (/work/shared/seeds/000_*.txt, Parts 1 and 2) written anew in Python, as the
-peer btc's py_trees compile is measured against (lang/benches/rules.rs).
+peer btc's py_trees compile is measured against (lang/benches/compile_scale.rs).
 
 Usage: python3 p3_seed_generator.py PLAN OUTPUT
 """
