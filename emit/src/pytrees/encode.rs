@@ -8,7 +8,7 @@
 //! `?#i` back to the argument. Regrounding gives back exactly the value
 //! written, whichever argument an object is taken for.
 
-use super::names::py_str;
+use super::names::{push_py_str, py_str};
 use btc_ir::{format_float, PortValue};
 use btc_pddl::logic::TypedVar;
 use btc_pddl::logic::{AssignOp, Atom, Comparison, Effect, Formula, NumExpr, NumOp, Term};
@@ -28,7 +28,7 @@ impl Encoder<'_> {
                 Some(i) => {
                     let _ = write!(self.out, "\"?#{i}\"");
                 }
-                None => self.out.push_str(&py_str(o)),
+                None => push_py_str(self.out, o),
             },
         }
     }
@@ -40,7 +40,7 @@ impl Encoder<'_> {
             self.out.push_str(h);
             self.out.push_str(", ");
         }
-        self.out.push_str(&py_str(&a.pred));
+        push_py_str(self.out, &a.pred);
         for t in &a.args {
             self.out.push_str(", ");
             self.term(t);
@@ -252,7 +252,7 @@ pub fn py_float(f: f64) -> String {
 /// is `("$", name)`, a KB formula or effect its tuple.
 pub fn port_value(v: &PortValue, out: &mut String) {
     match v {
-        PortValue::Text(s) => out.push_str(&py_str(s)),
+        PortValue::Text(s) => push_py_str(out, s),
         PortValue::Int(n) => {
             let _ = write!(out, "{n}");
         }

@@ -21,7 +21,7 @@ use btc_ir::{ControlKind, Count, DecoratorKind};
 use btc_ir::{LeafKind, Node, NodeModel, Port, StepInfo, TreeIr};
 use btc_pddl::logic::InitFact;
 use names::{is_plain_kwarg, RESERVED};
-pub use names::{py_ident, py_str, Names};
+pub use names::{push_py_str, py_ident, py_str, Names};
 use std::collections::HashMap;
 use std::fmt::Write;
 
@@ -561,7 +561,7 @@ fn ports_tuple(ports: &[Port], o: &mut String) {
     o.push('(');
     for p in ports {
         o.push('(');
-        o.push_str(&py_str(&p.name));
+        push_py_str(o, &p.name);
         o.push_str(", ");
         encode::port_value(&p.value, o);
         o.push_str("), ");
@@ -572,7 +572,7 @@ fn ports_tuple(ports: &[Port], o: &mut String) {
 /// `(action, pre_start, pre_over_all, pre_end, eff_start, eff_end)`, lifted.
 fn shape_of(s: &StepInfo, out: &mut String) {
     out.push('(');
-    out.push_str(&py_str(&s.action));
+    push_py_str(out, &s.action);
     let mut e = encode::Encoder { out, args: &s.args };
     for f in [&s.pre_start, &s.pre_over_all, &s.pre_end] {
         e.out.push_str(", ");
@@ -588,7 +588,7 @@ fn shape_of(s: &StepInfo, out: &mut String) {
 fn row_of(s: &StepInfo, shape: usize, out: &mut String) {
     let _ = write!(out, "    ({shape}, (");
     for a in &s.args {
-        out.push_str(&py_str(a));
+        push_py_str(out, a);
         out.push_str(", ");
     }
     out.push(')');

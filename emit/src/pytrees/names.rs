@@ -134,7 +134,22 @@ pub(crate) const RESERVED: &[&str] = &[
 /// breaks, so it is safe anywhere a literal goes (and inside a comment).
 pub fn py_str(s: &str) -> String {
     let mut out = String::with_capacity(s.len() + 2);
+    push_py_str(&mut out, s);
+    out
+}
+
+/// [`py_str`] appended to `out`: the module writes one literal per name of
+/// every step, so this path allocates nothing.
+pub fn push_py_str(out: &mut String, s: &str) {
     out.push('"');
+    // Names are almost always plain printable ASCII: copied whole.
+    if s.bytes()
+        .all(|b| (b' '..=b'~').contains(&b) && b != b'\\' && b != b'"')
+    {
+        out.push_str(s);
+        out.push('"');
+        return;
+    }
     for c in s.chars() {
         match c {
             '\\' => out.push_str("\\\\"),
@@ -155,7 +170,6 @@ pub fn py_str(s: &str) -> String {
         }
     }
     out.push('"');
-    out
 }
 
 /// `s` made a Python identifier `[A-Za-z_][A-Za-z0-9_]*` for a class name:
