@@ -93,12 +93,21 @@ pub fn check(path: &Path, format: Format) -> anyhow::Result<ExitCode> {
     })
 }
 
+/// What `btc compile` writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Output {
+    /// The compiled tree in a format.
+    Tree(emit::Format),
+    /// The problem's world as a `.kb` file (for the C++ knowledge base).
+    Kb,
+}
+
 pub struct CompileArgs {
     pub rules: PathBuf,
     pub plan: PathBuf,
     pub problem: Option<PathBuf>,
     pub domain: Option<PathBuf>,
-    pub emit: emit::Format,
+    pub emit: Output,
     pub output: Option<PathBuf>,
     pub options: emit::Options,
     pub format: Format,
@@ -189,7 +198,7 @@ pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
         db::compile(&database, job).as_ref().ok()
     };
     // What the target cannot express is refused, never approximated.
-    if let (Some(ir), emit::Format::Pytrees) = (result, a.emit) {
+    if let (Some(ir), Output::Tree(emit::Format::Pytrees)) = (result, a.emit) {
         let refused = targets::refusals(&database, job, ir, targets::Target::Pytrees);
         if !refused.is_empty() {
             diags.extend(refused);
@@ -220,15 +229,21 @@ pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
     };
     let text = match (&a.output, a.emit) {
         // A JSON IR records its PDDL files relative to itself.
-        (Some(out), emit::Format::Json) => {
+        (Some(out), Output::Tree(f @ emit::Format::Json)) => {
             let mut ir = ir.clone();
             let dir = out.parent().unwrap_or(Path::new(""));
             for p in [&mut ir.domain, &mut ir.problem] {
                 *p = crate::paths::text(&crate::paths::relative_to(Path::new(p.as_str()), dir));
             }
-            emit::emit(&ir, a.emit, &a.options)
+            emit::emit(&ir, f, &a.options)
         }
-        _ => emit::emit(ir, a.emit, &a.options),
+        (_, Output::Tree(f)) => emit::emit(ir, f, &a.options),
+        (_, Output::Kb) => match db::JobWorld::of(&database, job) {
+            Some(w) => emit::kb::emit(w.domain, w.dix, w.problem, w.pix),
+            None => anyhow::bail!(
+                "`--emit kb` needs the PDDL problem: pass `--problem PROBLEM` or name it in the rules file"
+            ),
+        },
     };
     match &a.output {
         Some(out) => {
@@ -243,7 +258,7 @@ pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
             );
             // An imported runtime goes beside the module, where its import
             // finds it; it is btc's file and always rewritten.
-            if a.emit == emit::Format::Pytrees
+            if a.emit == Output::Tree(emit::Format::Pytrees)
                 && a.options.runtime == emit::pytrees::Runtime::Import
             {
                 let dir = out.parent().unwrap_or(Path::new(""));
