@@ -92,6 +92,10 @@ enum Command {
         /// py_trees: import leaf behaviours from this Python module.
         #[arg(long)]
         node_module: Option<String>,
+        /// py_trees: paste btc's runtime into the module, or import it
+        /// (`btc_runtime.py`, written beside an `-o` output).
+        #[arg(long, value_enum, default_value_t = RuntimeArg::Inline)]
+        runtime: RuntimeArg,
         /// How to print diagnostics.
         #[arg(long, value_enum, default_value_t)]
         format: Format,
@@ -223,6 +227,24 @@ impl From<EmitFormat> for rules_cmd::Output {
     }
 }
 
+/// How a py_trees module gets btc's runtime.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum RuntimeArg {
+    /// Pasted into the module: one self-contained file.
+    Inline,
+    /// `from btc_runtime import ...`: smaller modules sharing one runtime.
+    Import,
+}
+
+impl From<RuntimeArg> for btc_emit::pytrees::Runtime {
+    fn from(r: RuntimeArg) -> Self {
+        match r {
+            RuntimeArg::Inline => btc_emit::pytrees::Runtime::Inline,
+            RuntimeArg::Import => btc_emit::pytrees::Runtime::Import,
+        }
+    }
+}
+
 fn plan_options(
     search: SearchArg,
     heuristic: HeuristicArg,
@@ -274,6 +296,7 @@ fn main() -> ExitCode {
             output,
             inline,
             node_module,
+            runtime,
             format,
         } => rules_cmd::compile(&rules_cmd::CompileArgs {
             rules,
@@ -285,6 +308,7 @@ fn main() -> ExitCode {
             options: btc_emit::Options {
                 inline,
                 node_module,
+                runtime: runtime.into(),
             },
             format,
         }),

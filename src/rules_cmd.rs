@@ -5,6 +5,7 @@ use crate::{files, report, Format};
 use btc_emit as emit;
 use btc_lang::db::{self, CompileJob, Database, SourceFile};
 use btc_lang::rules::{ImportTarget, Item};
+use btc_lang::targets;
 use btc_pddl::diagnostic::{has_errors, Diagnostic};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -191,11 +192,19 @@ pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
         a.domain.as_deref(),
         &mut diags,
     )?;
-    let result = if has_errors(&diags) {
+    let mut result = if has_errors(&diags) {
         None
     } else {
         db::compile(&database, job).as_ref().ok()
     };
+    // What the target cannot express is refused, never approximated.
+    if let (Some(ir), Output::Tree(emit::Format::Pytrees)) = (result, a.emit) {
+        let refused = targets::refusals(&database, job, ir, targets::Target::Pytrees);
+        if !refused.is_empty() {
+            diags.extend(refused);
+            result = None;
+        }
+    }
     if result.is_none() {
         if let Err(errs) = db::compile(&database, job) {
             for e in errs {
@@ -247,6 +256,16 @@ pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
                 ir.steps.len(),
                 ir.steps.len() - steps
             );
+            // An imported runtime goes beside the module, where its import
+            // finds it; it is btc's file and always rewritten.
+            if a.emit == Output::Tree(emit::Format::Pytrees)
+                && a.options.runtime == emit::pytrees::Runtime::Import
+            {
+                let dir = out.parent().unwrap_or(Path::new(""));
+                let rt = dir.join(format!("{}.py", emit::pytrees::RUNTIME_MODULE));
+                files::write_atomically(&rt, emit::pytrees::RUNTIME)?;
+                eprintln!("wrote {}", rt.display());
+            }
         }
         None => print!("{text}"),
     }

@@ -65,12 +65,20 @@ pub struct Options {
     /// py_trees: import leaf behaviours from this module instead of
     /// generating simulated ones.
     pub node_module: Option<String>,
+    /// py_trees: paste the runtime in, or import `btc_runtime`.
+    pub runtime: pytrees::Runtime,
 }
 
 pub fn emit(ir: &TreeIr, format: Format, options: &Options) -> String {
     match format {
         Format::Btcpp => btcpp::emit(ir, options.inline),
-        Format::Pytrees => pytrees::emit(ir, options.node_module.as_deref()),
+        Format::Pytrees => pytrees::emit(
+            ir,
+            &pytrees::PyOptions {
+                runtime: options.runtime,
+                node_module: options.node_module.as_deref(),
+            },
+        ),
         Format::Json => serde_json::to_string_pretty(ir).expect("the IR serializes") + "\n",
         Format::Dot => dot::emit_dot(ir),
         Format::Mermaid => dot::emit_mermaid(ir),

@@ -10,3 +10,4 @@ pub mod db;
 pub mod declared;
 pub mod lower;
 pub mod rules;
+pub mod targets;

@@ -5,7 +5,7 @@
 //!
 //! Needs `python3` with py_trees 2.2 or later (`pip install py_trees`).
 
-use btc_emit::pytrees;
+use btc_emit::pytrees::{self, PyOptions};
 use btc_ir::{ControlKind, DecoratorKind};
 use btc_ir::{
     LeafKind, Node, NodeModel, Port, PortDirection, PortModel, PortValue, StepInfo, TreeDef,
@@ -131,8 +131,12 @@ fn compile_example(dir: &Path) -> TreeIr {
 
 /// Emits `ir`, checks the text, and runs it to SUCCESS in a fresh directory.
 fn emit_and_run(ir: &TreeIr, name: &str) -> String {
-    let text = pytrees::emit(ir, None);
-    assert_eq!(text, pytrees::emit(ir, None), "{name}: not deterministic");
+    let text = pytrees::emit(ir, &PyOptions::default());
+    assert_eq!(
+        text,
+        pytrees::emit(ir, &PyOptions::default()),
+        "{name}: not deterministic"
+    );
     assert!(text.is_ascii(), "{name}: output is not ASCII");
     let work = work_dir(name);
     std::fs::write(work.join("module.py"), &text).unwrap();
@@ -188,19 +192,17 @@ fn fixtures_run_to_success() {
     // The workshop jobs between them use every construct.
     let all: String = ran.iter().map(|(_, t)| t.as_str()).collect();
     for construct in [
-        "ThresholdParallel(",
-        "ParallelPolicy.SuccessOnAll(",
-        "ParallelPolicy.SuccessOnOne(",
-        "py_trees.decorators.Timeout(",
-        "py_trees.decorators.Retry(",
-        "py_trees.decorators.Repeat(",
-        "py_trees.decorators.Inverter(",
-        "py_trees.decorators.FailureIsSuccess(",
-        "py_trees.decorators.SuccessIsFailure(",
-        "py_trees.composites.Selector(name=\"ReactiveFallback\", memory=False",
-        "py_trees.composites.Selector(name=",
-        "KbHolds(",
-        "WaitForStep(",
+        "(\"P\", ",
+        "(\"D\", \"timeout\", ",
+        "(\"D\", \"retry\", ",
+        "(\"D\", \"repeat\", ",
+        "(\"D\", \"inverter\", ",
+        "(\"D\", \"force_success\", ",
+        "(\"D\", \"force_failure\", ",
+        "(\"f\", ",
+        "(\"F\", ",
+        "(\"KbHolds\", KbHolds)",
+        "(\"WaitForStep\", WaitForStep)",
     ] {
         assert!(all.contains(construct), "no job emits {construct}");
     }
@@ -240,10 +242,16 @@ fn examples_run_with_a_node_module() {
     for dir in example_dirs() {
         let name = dir.file_name().unwrap().to_string_lossy().into_owned();
         let ir = compile_example(&dir);
-        let text = pytrees::emit(&ir, Some("user_nodes"));
+        let text = pytrees::emit(
+            &ir,
+            &PyOptions {
+                node_module: Some("user_nodes"),
+                ..PyOptions::default()
+            },
+        );
         assert!(text.contains("\nimport user_nodes\n"), "{name}");
         assert!(
-            !text.contains("(SimulatedAction)"),
+            !text.contains("(Action):"),
             "{name}: simulated classes emitted"
         );
         let work = work_dir(&format!("{name}_node_module"));
@@ -251,6 +259,50 @@ fn examples_run_with_a_node_module() {
         std::fs::write(work.join("user_nodes.py"), USER_NODES).unwrap();
         assert_runs_to_success(&work, &format!("{name} with user_nodes"));
     }
+}
+
+/// The P3 example with its own behaviours (`examples/p3_assembler/pytrees/`,
+/// derived from the runtime's bases) and the runtime imported: the tree runs
+/// to SUCCESS with the goal reached, and the behaviours did the work.
+#[test]
+fn the_p3_example_runs_with_its_own_behaviours() {
+    if !btc_testkit::py_trees() {
+        return;
+    }
+    let dir = repo_root().join("examples/p3_assembler");
+    let ir = compile_example(&dir);
+    let text = pytrees::emit(
+        &ir,
+        &PyOptions {
+            runtime: pytrees::Runtime::Import,
+            node_module: Some("p3_nodes"),
+        },
+    );
+    assert!(text.contains("\nfrom btc_runtime import (\n"));
+    assert!(
+        !text.contains("class KnowledgeBase"),
+        "the runtime was pasted"
+    );
+    let work = work_dir("p3_own_behaviours");
+    std::fs::write(work.join("module.py"), &text).unwrap();
+    std::fs::write(work.join("btc_runtime.py"), pytrees::RUNTIME).unwrap();
+    std::fs::copy(dir.join("pytrees/p3_nodes.py"), work.join("p3_nodes.py")).unwrap();
+    assert_runs_to_success(&work, "p3 with p3_nodes");
+    // Importing has no side effects; the behaviours log what they did.
+    let check = "import module, p3_nodes\n\
+                 assert p3_nodes.ROBOT.log == []\n\
+                 import btc_runtime as rt\n\
+                 kb = rt.KnowledgeBase(module.WORLD, module.PLAN)\n\
+                 r = rt.run(module.create_behavior_tree(), kb, module.MAX_TICKS)\n\
+                 assert r.success(), r.as_json()\n\
+                 print(p3_nodes.ROBOT.log)\n";
+    let out = run_python(&work, &["-c", check]);
+    assert!(out.status.success(), "{}", show(&out));
+    let log = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        log.contains("'picked screwdriver'") && log.contains("'placed drill'"),
+        "{log}"
+    );
 }
 
 // ---------------------------------------------------------------------------
@@ -449,7 +501,10 @@ fn hostile_ir() -> TreeIr {
         Action,
         "KbApply",
         None,
-        vec![port("effect", text(&format!("(done {OBJ_B})")))],
+        vec![port(
+            "effect",
+            PortValue::Effect(Effect::Add(atom("done", &[OBJ_B]))),
+        )],
     ));
     TreeIr {
         version: IR_VERSION,
@@ -535,8 +590,8 @@ def walk(b):
         walk(c)
 walk(m.create_behavior_tree())
 json.dump({
-    "objects": list(m.OBJECTS.items()),
-    "facts": sorted(list(f) for f in m.INITIAL_FACTS),
+    "objects": [[o, m.WORLD.object_types[o][0]] for o in m.WORLD.objects],
+    "facts": sorted(list(f) for f in m.WORLD.init),
     "classes": m.NODE_CLASS_NAMES,
     "names": names,
 }, sys.stdout)
@@ -549,14 +604,28 @@ fn hostile_names_stay_strings() {
     }
     let ir = hostile_ir();
     for module in [None, Some("user_nodes")] {
-        let text = pytrees::emit(&ir, module);
+        let text = pytrees::emit(
+            &ir,
+            &PyOptions {
+                node_module: module,
+                ..PyOptions::default()
+            },
+        );
         assert!(text.is_ascii());
         for line in text.lines() {
             // No user text leaks outside a literal: the only `import` lines
             // are the module's own.
             if line.trim_start().starts_with("import ") {
                 assert!(
-                    ["import sys", "import py_trees", "import user_nodes"].contains(&line.trim()),
+                    [
+                        "import sys",
+                        "import py_trees",
+                        "import user_nodes",
+                        "import argparse",
+                        "import json",
+                        "import time",
+                    ]
+                    .contains(&line.trim()),
                     "unexpected import line: {line}"
                 );
             }
@@ -619,78 +688,6 @@ fn hostile_names_stay_strings() {
     }
 }
 
-/// Checks of the generated PDDL evaluator, run inside the workshop module.
-const EVALUATOR_CHECKS: &str = r#"
-import importlib.util
-spec = importlib.util.spec_from_file_location("module", "module.py")
-m = importlib.util.module_from_spec(spec)
-spec.loader.exec_module(m)
-kb, p = m.KnowledgeBase(), m.parse_pddl
-
-def holds(text, env=None):
-    return kb.holds(p(text), env)
-
-assert p("(On  A\n(b c))") == ("on", "a", ("b", "c"))
-for bad in ["(a", "a)", "", "(a) (b)"]:
-    try:
-        p(bad)
-    except ValueError:
-        pass
-    else:
-        raise AssertionError("parsed %r" % bad)
-assert holds("(at r1 base)") and holds("(AT R1 Base)")
-assert not holds("(at r1 dock)")
-assert holds("(and (at r1 base) (not (at r1 dock)) (or (at r1 dock) (free r1)))")
-assert holds("(imply (at r1 dock) (checked dock))")
-assert not holds("(imply (at r1 base) (checked dock))")
-assert holds("(= base base)") and not holds("(= base dock)")
-assert holds("(exists (?r - robot) (at ?r base))")
-assert holds("(forall (?r - robot) (at ?r base))")
-assert not holds("(exists (?l - location) (checked ?l))")
-assert holds("(forall (?x ?y - robot) (imply (= ?x ?y) (free ?x)))")
-assert holds("(at ?r ?l)", {"?r": "r1", "?l": "base"})
-# Only the leaf type is known: `agent` (robot's supertype) has no objects.
-assert m.objects_of_type("robot") == ["r1", "r2"]
-assert m.objects_of_type("agent") == []
-assert len(m.objects_of_type("object")) == len(m.OBJECTS)
-assert m.objects_of_type(("either", "robot", "item")) == ["r1", "r2", "i1", "i2"]
-# Delete before add; every part sees the state before the effect.
-kb.apply(p("(and (at r1 base) (not (at r1 base)))"))
-assert holds("(at r1 base)")
-kb.apply(p("(and (not (free r1)) (when (free r1) (checked base)))"))
-assert holds("(and (not (free r1)) (checked base))")
-kb.apply(p("(forall (?i - item) (when (item_at ?i shelf_a) (counted ?i)))"))
-assert holds("(counted i1)") and not holds("(counted i2)")
-kb.apply(p("(and (increase (total-cost) 2) (increase (total-cost) 1))"))
-assert kb.fluents[("total-cost",)] == 3.0
-assert holds("(and (>= (total-cost) 3) (< (total-cost) (+ 1 3)) (= (total-cost) 3))")
-kb.apply(p("(decrease (total-cost) (* 2 (total-cost)))"))
-assert holds("(= (total-cost) -3)")
-kb.reset()
-# The problem's initial values come back (the IR carries them).
-assert not holds("(counted i1)") and holds("(free r1)")
-assert kb.fluents == {("total-cost",): 0.0}
-assert not m.goal_reached(kb)
-print("evaluator ok")
-"#;
-
-#[test]
-fn generated_evaluator_follows_pddl() {
-    if !btc_testkit::py_trees() {
-        return;
-    }
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/pytrees/workshop");
-    let ir = compile_dir(&dir, "in_order.btrules");
-    let work = work_dir("evaluator");
-    std::fs::write(work.join("module.py"), pytrees::emit(&ir, None)).unwrap();
-    let out = run_python(&work, &["-c", EVALUATOR_CHECKS]);
-    assert!(
-        out.status.success() && String::from_utf8_lossy(&out.stdout).contains("evaluator ok"),
-        "{}",
-        show(&out)
-    );
-}
-
 /// A tree whose condition fails ends in FAILURE: exit 1, goal not reached.
 #[test]
 fn failure_exits_nonzero() {
@@ -706,7 +703,10 @@ fn failure_exits_nonzero() {
                 LeafKind::Action,
                 "KbApply",
                 None,
-                vec![port("effect", text(&format!("(not (at {OBJ_A} {OBJ_B}))")))],
+                vec![port(
+                    "effect",
+                    PortValue::Effect(Effect::Delete(atom("at", &[OBJ_A, OBJ_B]))),
+                )],
             ),
             leaf(
                 LeafKind::Condition,
@@ -717,7 +717,11 @@ fn failure_exits_nonzero() {
         ],
     };
     let work = work_dir("failure");
-    std::fs::write(work.join("module.py"), pytrees::emit(&ir, None)).unwrap();
+    std::fs::write(
+        work.join("module.py"),
+        pytrees::emit(&ir, &PyOptions::default()),
+    )
+    .unwrap();
     let out = run_python(&work, &["module.py"]);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert_eq!(out.status.code(), Some(1), "{}", show(&out));

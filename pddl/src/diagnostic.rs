@@ -332,6 +332,8 @@ pub mod codes {
         // Node palettes imported from BT.CPP XML (`import "nodes.xml"`)
         R_PALETTE = "R070", "an imported node palette that is not BT.CPP XML with a <TreeNodesModel>";
         R_PALETTE_TYPE = "R071", "a palette port whose C++ type btc cannot check";
+        // Emitting (btc compile --emit): what a target cannot express
+        E_PYTREES_NODE = "E001", "a node a py_trees module cannot run as btc's engine does";
         // Running trees (btc run)
         X_TREE_SYNTAX = "X001", "a behavior tree file that is not BT.CPP v4 XML or btc's JSON IR";
         X_UNKNOWN_NODE = "X002", "a tree node that is neither built in nor declared";

@@ -321,6 +321,48 @@ pub fn target_dir(name: &str) -> PathBuf {
 /// A valid ARIAC plan of exactly `steps` steps: the robot carries the red
 /// battery between bin1 and agv1, ending with it on agv1 when
 /// `steps % 6 == 4` (as for 100,000).
+/// A valid timed plan of `steps` steps for `examples/p3_assembler` in the
+/// P3 generator's input format: the example's first four steps, then a
+/// cycle of picks and places at the assembly station (with a self-move the
+/// rules skip, a wait and a round trip), times increasing.
+pub fn long_p3_plan(steps: usize) -> String {
+    let start = [
+        ("MOVE_TO robot1 home tool_rack", 2.0),
+        ("PICK_OP1 robot1 screwdriver tool_rack", 3.0),
+        ("MOVE_TO robot1 tool_rack assembly_station", 2.0),
+        ("PLACE_OP1 robot1 screwdriver", 3.0),
+    ];
+    let mut out = String::with_capacity(steps * 48);
+    let mut t = 0.0f64;
+    let mut push = |out: &mut String, a: &str, d: f64| {
+        out.push_str(&format!("{t:.3}: ({a}) [{d:.3}]\n"));
+        t += d + 0.001;
+    };
+    for (a, d) in start.iter().take(steps) {
+        push(&mut out, a, *d);
+    }
+    for i in 0..steps.saturating_sub(start.len()) {
+        let op = 1 + (i / 6) % 3;
+        match i % 6 {
+            0 => push(
+                &mut out,
+                &format!("PICK_OP{op} robot1 screwdriver assembly_station"),
+                3.0,
+            ),
+            1 => push(
+                &mut out,
+                "MOVE_TO robot1 assembly_station assembly_station",
+                2.0,
+            ),
+            2 => push(&mut out, &format!("PLACE_OP{op} robot1 screwdriver"), 3.0),
+            3 => push(&mut out, "WAIT robot1", 1.0),
+            4 => push(&mut out, "MOVE_TO robot1 assembly_station tool_rack", 2.0),
+            _ => push(&mut out, "MOVE_TO robot1 tool_rack assembly_station", 2.0),
+        }
+    }
+    out
+}
+
 pub fn long_ariac_plan(steps: usize) -> String {
     let mut s = String::from("(move floor_robot curr_position bin1)\n");
     let cycle = [

@@ -59,30 +59,52 @@ pub fn example(name: &str) -> Example {
 /// A folder with `rules.btrules`, `problem.pddl`, a domain and a `plan.*`,
 /// compiled (`name` for messages).
 pub fn compile_dir(dir: &Path, name: &str) -> Example {
+    let mut plans: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| {
+            p.file_name()
+                .unwrap()
+                .to_string_lossy()
+                .starts_with("plan.")
+        })
+        .collect();
+    plans.sort();
+    let plan = plans
+        .first()
+        .unwrap_or_else(|| panic!("{name}: no plan.* file"));
+    load(&dir.join("rules.btrules"), plan, &dir.join("problem.pddl"))
+}
+
+/// Compiles `rules` with `plan` and `problem`; every file of the rules'
+/// folder and the domain the rules file names are loaded.
+pub fn load(rules: &Path, plan: &Path, problem: &Path) -> Example {
     let mut db = Database::new();
-    let mut rules = None;
-    let mut plan = None;
+    let dir = rules.parent().unwrap();
+    let text = std::fs::read_to_string(rules).unwrap();
+    let extra: Vec<PathBuf> = text
+        .lines()
+        .find_map(|l| l.trim().strip_prefix("domain \""))
+        .map(|d| dir.join(d.trim_end_matches('"')))
+        .into_iter()
+        .collect();
     let mut names: Vec<PathBuf> = std::fs::read_dir(dir)
         .unwrap()
         .map(|e| e.unwrap().path())
         .filter(|p| p.is_file())
         .collect();
+    names.extend(extra);
+    names.extend([plan.to_path_buf(), problem.to_path_buf()]);
     names.sort();
-    for p in names {
-        let name = p.file_name().unwrap().to_string_lossy().into_owned();
-        let f = db.set_file(&db::normalize(&p), std::fs::read_to_string(&p).unwrap());
-        if name.starts_with("plan.") && plan.is_none() {
-            plan = Some(f);
-        }
-        if name == "rules.btrules" {
-            rules = Some(f);
-        }
+    names.dedup();
+    for p in &names {
+        db.set_file(&db::normalize(p), std::fs::read_to_string(p).unwrap());
     }
-    let problem = db.file(&db::normalize(&dir.join("problem.pddl")));
-    let job = CompileJob::new(&db, rules.unwrap(), plan.unwrap(), problem, None);
+    let file = |p: &Path| db.file(&db::normalize(p)).unwrap();
+    let job = CompileJob::new(&db, file(rules), file(plan), Some(file(problem)), None);
     let ir = db::compile(&db, job)
         .as_ref()
-        .unwrap_or_else(|e| panic!("{name}: {e:#?}"))
+        .unwrap_or_else(|e| panic!("{}: {e:#?}", rules.display()))
         .clone();
     Example { db, job, ir }
 }

@@ -1,0 +1,179 @@
+//! Compile speed and size at scale (#14), against a seed-style generator in
+//! the same run: `cargo bench -p btc-lang --bench compile_scale`.
+//!
+//! A 100,000-step timed plan of the P3 shape (`btc_testkit::long_p3_plan`)
+//! is compiled from texts (parse, check, lower, emit) to a py_trees module
+//! (runtime imported), to BT.CPP XML and to JSON. The peer is
+//! `benches/peers/p3_seed_generator.py`, the P3 seed's algorithm written
+//! anew in Python, timed as a whole process on the same plan. Printed per
+//! format: median time of 5 and the speed-up over the peer, peak heap during
+//! the compile next to the output's size, bytes per step next to the
+//! peer's; each with its target.
+
+use btc_emit::{emit, pytrees::Runtime, Format, Options};
+use btc_lang::db::{compile, CompileJob, Database};
+use std::alloc::{GlobalAlloc, Layout};
+use std::path::Path;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::{Duration, Instant};
+
+/// mimalloc (as the `btc` binary) with the live and the peak heap counted.
+struct Counting;
+
+static LIVE: AtomicUsize = AtomicUsize::new(0);
+static PEAK: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
+        let p = unsafe { mimalloc::MiMalloc.alloc(l) };
+        let now = LIVE.fetch_add(l.size(), Ordering::Relaxed) + l.size();
+        PEAK.fetch_max(now, Ordering::Relaxed);
+        p
+    }
+
+    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
+        LIVE.fetch_sub(l.size(), Ordering::Relaxed);
+        unsafe { mimalloc::MiMalloc.dealloc(p, l) }
+    }
+
+    unsafe fn realloc(&self, p: *mut u8, l: Layout, new: usize) -> *mut u8 {
+        let q = unsafe { mimalloc::MiMalloc.realloc(p, l, new) };
+        if new >= l.size() {
+            let now = LIVE.fetch_add(new - l.size(), Ordering::Relaxed) + new - l.size();
+            PEAK.fetch_max(now, Ordering::Relaxed);
+        } else {
+            LIVE.fetch_sub(l.size() - new, Ordering::Relaxed);
+        }
+        q
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+const STEPS: usize = 100_000;
+const RUNS: usize = 5;
+const DOMAIN: &str = include_str!("../../examples/p3_assembler/domain.pddl");
+const PROBLEM: &str = include_str!("../../examples/p3_assembler/problem.pddl");
+const RULES: &str = include_str!("../../examples/p3_assembler/rules.btrules");
+
+fn median(mut v: Vec<Duration>) -> Duration {
+    v.sort();
+    v[v.len() / 2]
+}
+
+/// One compile from texts to `format`: its output, the peak heap above
+/// what was live before it, and the time the emitter took of it.
+fn compile_once(plan: &str, format: Format) -> (String, usize, Duration) {
+    let base = LIVE.load(Ordering::Relaxed);
+    PEAK.store(base, Ordering::Relaxed);
+    let mut db = Database::new();
+    db.set_file("p3/domain.pddl", DOMAIN.to_owned());
+    let p = db.set_file("p3/problem.pddl", PROBLEM.to_owned());
+    let r = db.set_file("p3/rules.btrules", RULES.to_owned());
+    let l = db.set_file("p3/plan.tplan", plan.to_owned());
+    let job = CompileJob::new(&db, r, l, Some(p), None);
+    let ir = compile(&db, job).as_ref().expect("the plan compiles");
+    let options = Options {
+        runtime: Runtime::Import,
+        ..Options::default()
+    };
+    let t = Instant::now();
+    let text = emit(ir, format, &options);
+    let emitting = t.elapsed();
+    drop(db);
+    (text, PEAK.load(Ordering::Relaxed) - base, emitting)
+}
+
+/// The peer on the same plan, whole process: median time and bytes written.
+fn peer(plan_path: &Path, out: &Path) -> Option<(Duration, usize)> {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/peers/p3_seed_generator.py");
+    let mut times = Vec::new();
+    for _ in 0..RUNS {
+        let t = Instant::now();
+        let status = std::process::Command::new("python3")
+            .arg(&script)
+            .arg(plan_path)
+            .arg(out)
+            .stdout(std::process::Stdio::null())
+            .status()
+            .ok()?;
+        if !status.success() {
+            return None;
+        }
+        times.push(t.elapsed());
+    }
+    Some((median(times), std::fs::metadata(out).ok()?.len() as usize))
+}
+
+fn mb(bytes: usize) -> f64 {
+    bytes as f64 / 1e6
+}
+
+fn main() {
+    // `cargo test --benches` runs this with `--bench` absent: stay quick.
+    if !std::env::args().any(|a| a == "--bench") {
+        println!("compile_scale: run with `cargo bench` for figures");
+        return;
+    }
+    let plan = btc_testkit::long_p3_plan(STEPS);
+    let dir = std::env::temp_dir().join(format!("btc-compile-scale-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let plan_path = dir.join("plan.tplan");
+    std::fs::write(&plan_path, &plan).unwrap();
+    let peer = peer(&plan_path, &dir.join("peer.py"));
+    match peer {
+        Some((t, bytes)) => println!(
+            "peer (seed-style Python generator): {STEPS} steps in {:.0} ms, {:.1} MB ({:.0} bytes/step)",
+            t.as_secs_f64() * 1e3,
+            mb(bytes),
+            bytes as f64 / STEPS as f64
+        ),
+        None => println!("peer: python3 could not run the seed-style generator"),
+    }
+    for (format, speed_target) in [
+        (Format::Pytrees, Some(20.0)),
+        (Format::Btcpp, Some(25.0)),
+        (Format::Json, None),
+    ] {
+        let mut times = Vec::new();
+        let mut emit_times = Vec::new();
+        let mut out = (String::new(), 0);
+        for _ in 0..RUNS {
+            let t = Instant::now();
+            let (text, peak, emitting) = compile_once(&plan, format);
+            times.push(t.elapsed());
+            emit_times.push(emitting);
+            out = (text, peak);
+        }
+        let t = median(times);
+        let (text, peak) = out;
+        let mut line = format!(
+            "{:8}: {:.0} ms (emitting {:.0} ms of it)",
+            format.name(),
+            t.as_secs_f64() * 1e3,
+            median(emit_times).as_secs_f64() * 1e3
+        );
+        if let (Some((pt, _)), Some(target)) = (peer, speed_target) {
+            line += &format!(
+                " = {:.1}x the peer (target >= {target}x)",
+                pt.as_secs_f64() / t.as_secs_f64()
+            );
+        }
+        line += &format!(
+            "; peak heap {:.0} MB for {:.1} MB out = {:.2}x (target <= 2x)",
+            mb(peak),
+            mb(text.len()),
+            peak as f64 / text.len() as f64
+        );
+        if let (Some((_, pb)), Format::Pytrees) = (peer, format) {
+            line += &format!(
+                "; {:.0} bytes/step = {:.2}x the peer's (target <= 1.2x)",
+                text.len() as f64 / STEPS as f64,
+                text.len() as f64 / pb as f64
+            );
+        }
+        println!("{line}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,0 +1,127 @@
+//! What an output target cannot express, found where the rules say it:
+//! compiling for that target is refused with a diagnostic at each place,
+//! never approximated. Emitters only see the IR, which has no spans, so
+//! the refusals are found here, from the compiled tree and the rules.
+
+use crate::db::{self, CompileJob, Db};
+use crate::rules::ast::{Item, RuleBody, Template};
+use crate::rules::name::Key;
+use crate::rules::parse::shift;
+use btc_ir::{Node, TreeIr};
+use btc_pddl::diagnostic::{codes, Diagnostic};
+use btc_pddl::source::Span;
+
+/// An output format with something it cannot express.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Target {
+    /// A py_trees module (`--emit pytrees`).
+    Pytrees,
+}
+
+/// A leaf btc's engine gives a meaning that a py_trees module has no
+/// counterpart of, and why.
+struct Unsupported {
+    id: &'static str,
+    why: &'static str,
+    hint: &'static str,
+}
+
+/// `std::btcpp` leaves the py_trees runtime does not implement: as plain
+/// simulated actions they would take ticks and skip what btc's engine does.
+const NOT_IN_PYTREES: &[Unsupported] = &[
+    Unsupported {
+        id: "SetBlackboard",
+        why: "writes a blackboard entry that later ports read as `{key}`; a py_trees module fills its ports in when the tree is built, so nothing would read the value",
+        hint: "pass the value to the nodes that need it as a port, or emit BT.CPP XML (`--emit btcpp`)",
+    },
+    Unsupported {
+        id: "Script",
+        why: "runs BT.CPP script code; py_trees has no scripting language",
+        hint: "write the script's work as a behaviour of your own, or emit BT.CPP XML (`--emit btcpp`)",
+    },
+    Unsupported {
+        id: "ScriptCondition",
+        why: "evaluates BT.CPP script code; py_trees has no scripting language",
+        hint: "declare a `condition` defined by a PDDL formula instead, or emit BT.CPP XML (`--emit btcpp`)",
+    },
+];
+
+/// Why `target` cannot express the tree `ir` compiled from `job`: one
+/// diagnostic per place in the rules that uses something the target lacks
+/// (none when it can express all of it).
+pub fn refusals(db: &dyn Db, job: CompileJob, ir: &TreeIr, target: Target) -> Vec<Diagnostic> {
+    let Target::Pytrees = target;
+    let used: Vec<&Unsupported> = NOT_IN_PYTREES
+        .iter()
+        .filter(|u| uses_leaf(ir, u.id))
+        .collect();
+    if used.is_empty() {
+        return Vec::new();
+    }
+    let mut out = Vec::new();
+    let (files, _) = db::import_closure(db, job.rules(db));
+    for &file in files {
+        if file.path(db).starts_with("std::") {
+            continue;
+        }
+        let id = db::file_id(db, file);
+        for node in db::own_items(db, file) {
+            let mut found = Vec::new();
+            for t in templates(&node.item) {
+                calls(t, &mut found);
+            }
+            for (name, span) in found {
+                let Some(u) = used.iter().find(|u| name == Key::new(u.id)) else {
+                    continue;
+                };
+                let d = Diagnostic::error(
+                    codes::E_PYTREES_NODE,
+                    span,
+                    format!("a py_trees module cannot run `{}`, which {}", u.id, u.why),
+                )
+                .with_hint(u.hint);
+                out.push(shift(d, id, node.offset));
+            }
+        }
+    }
+    out.sort_by_key(|d| (d.span.file, d.span.start));
+    out
+}
+
+/// Whether a leaf `id` is in the compiled tree (the main tree or a rule's).
+fn uses_leaf(ir: &TreeIr, id: &str) -> bool {
+    let mut found = false;
+    let mut look = |n: &Node| {
+        if let Node::Leaf { id: leaf, .. } = n {
+            found |= leaf == id;
+        }
+    };
+    ir.root.walk(&mut look);
+    for t in &ir.trees {
+        t.root.walk(&mut look);
+    }
+    found
+}
+
+/// The templates of an item: a rule's body, a tree's, the plan's.
+fn templates(item: &Item) -> &[Template] {
+    match item {
+        Item::Rule(r) => match &r.body {
+            RuleBody::Template { body, .. } => body,
+            RuleBody::Skip { .. } => &[],
+        },
+        Item::Tree(t) => &t.body,
+        Item::Plan { body, .. } => body,
+        _ => &[],
+    }
+}
+
+/// Every call in a template (a leaf or a tree), with the span of its name.
+fn calls(t: &Template, out: &mut Vec<(Key, Span)>) {
+    match t {
+        Template::Control { children, .. } => children.iter().for_each(|c| calls(c, out)),
+        Template::Decorator { child, .. } => calls(child, out),
+        Template::Call { name, .. } => out.push((name.key.clone(), name.span)),
+        Template::Steps { .. } | Template::Error { .. } => {}
+    }
+}
