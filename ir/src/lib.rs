@@ -14,7 +14,9 @@ use btc_pddl::world::WorldModel;
 use serde::{Deserialize, Serialize};
 
 pub mod json;
+mod label;
 mod nodes;
+pub use label::{Label, LabelPart};
 pub use nodes::{ControlKind, Count, DecoratorKind};
 
 /// The version of the IR's JSON encoding (`"ir_version"`). Version 1 (PDDL
@@ -78,18 +80,18 @@ pub enum LeafKind {
 pub enum Node {
     Control {
         control: ControlKind,
-        name: Option<String>,
+        name: Option<Label>,
         children: Vec<Node>,
     },
     Decorator {
         decorator: DecoratorKind,
-        name: Option<String>,
+        name: Option<Label>,
         child: Box<Node>,
     },
     Leaf {
         leaf: LeafKind,
         id: String,
-        name: Option<String>,
+        name: Option<Label>,
         ports: Vec<Port>,
     },
     /// A call of a [`TreeDef`].
@@ -243,7 +245,7 @@ impl TreeIr {
                 children,
             } => Node::Control {
                 control: *control,
-                name: name.as_ref().map(|s| interpolate(s, args)),
+                name: name.as_ref().map(|s| s.fill(args)),
                 children: children
                     .iter()
                     .map(|c| self.inline_node(c, args, depth))
@@ -261,7 +263,7 @@ impl TreeIr {
                     },
                     _ => decorator.clone(),
                 },
-                name: name.as_ref().map(|s| interpolate(s, args)),
+                name: name.as_ref().map(|s| s.fill(args)),
                 child: Box::new(self.inline_node(child, args, depth)),
             },
             Node::Leaf {
@@ -272,7 +274,7 @@ impl TreeIr {
             } => Node::Leaf {
                 leaf: *leaf,
                 id: id.clone(),
-                name: name.as_ref().map(|s| interpolate(s, args)),
+                name: name.as_ref().map(|s| s.fill(args)),
                 ports: subst(ports),
             },
             Node::Step { step, child } => Node::Step {
@@ -311,13 +313,4 @@ fn count_of(param: &str, args: &[Port]) -> Option<Count> {
         PortValue::Param(p) => Some(Count::Param { param: p.clone() }),
         _ => None,
     }
-}
-
-/// Fills `{param}` in a node name from the call's arguments.
-fn interpolate(s: &str, args: &[Port]) -> String {
-    let mut out = s.to_owned();
-    for a in args {
-        out = out.replace(&format!("{{{}}}", a.name), &a.value.to_text());
-    }
-    out
 }
