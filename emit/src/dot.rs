@@ -33,7 +33,9 @@ fn leaf_label(id: &str, name: &Option<Label>, ports: &[Port]) -> String {
         .iter()
         .map(|p| format!("{}: {}", p.name, p.value.to_text()))
         .collect();
-    let head = name.as_ref().map_or_else(|| id.to_owned(), Label::to_string);
+    let head = name
+        .as_ref()
+        .map_or_else(|| id.to_owned(), Label::to_string);
     if args.is_empty() {
         head
     } else {

@@ -521,7 +521,11 @@ impl Emitter<'_> {
                 let kids: Vec<String> = children.iter().map(|c| self.node(c)).collect();
                 let kids = kids.join(", ");
                 let v = self.var();
-                let name = py_str(&name.as_ref().map_or_else(|| control_name(*control).to_owned(), ToString::to_string));
+                let name = py_str(
+                    &name
+                        .as_ref()
+                        .map_or_else(|| control_name(*control).to_owned(), ToString::to_string),
+                );
                 let expr = match *control {
                     ControlKind::Sequence => format!(
                         "py_trees.composites.Sequence(name={name}, memory=True, children=[{kids}])"
@@ -565,7 +569,11 @@ impl Emitter<'_> {
                 name,
                 child,
             } => {
-                let label = py_str(&name.as_ref().map_or_else(|| decorator_name(decorator), ToString::to_string));
+                let label = py_str(
+                    &name
+                        .as_ref()
+                        .map_or_else(|| decorator_name(decorator), ToString::to_string),
+                );
                 // BT.CPP ticks nothing under retry(0) / repeat(0).
                 match decorator {
                     DecoratorKind::Retry {
@@ -621,7 +629,11 @@ impl Emitter<'_> {
                 self.leaf_count += 1;
                 let v = self.var();
                 let class = &self.classes[id].expr;
-                let label = py_str(&name.as_ref().map_or_else(|| id.clone(), ToString::to_string));
+                let label = py_str(
+                    &name
+                        .as_ref()
+                        .map_or_else(|| id.clone(), ToString::to_string),
+                );
                 let _ = writeln!(self.out, "    {v} = {class}({label}{})", kwargs(ports));
                 v
             }

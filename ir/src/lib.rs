@@ -197,10 +197,18 @@ impl StepInfo {
 pub struct TreeIr {
     #[serde(rename = "ir_version")]
     pub version: u32,
-    /// The PDDL files it was compiled from (relative to the JSON file when
-    /// written with `-o`); informative: the world is [`TreeIr::world`].
+    /// The PDDL files it was compiled from (relative to the JSON file's
+    /// folder when written with `-o`); informative: the world is
+    /// [`TreeIr::world`].
     pub domain: String,
     pub problem: String,
+    /// The plan and the rules file it was compiled from, recorded like the
+    /// PDDL files; empty (and left out of the JSON) in files written before
+    /// btc recorded them.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub plan: String,
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub rules: String,
     pub main_tree: String,
     pub root: Node,
     pub trees: Vec<TreeDef>,

@@ -38,6 +38,8 @@ pub struct LowerInput<'a> {
     pub steps: &'a [GroundStep],
     pub domain_path: String,
     pub problem_path: String,
+    pub plan_path: String,
+    pub rules_path: String,
 }
 
 struct Types<'a> {
@@ -871,6 +873,8 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
         version: IR_VERSION,
         domain: input.domain_path.clone(),
         problem: input.problem_path.clone(),
+        plan: input.plan_path.clone(),
+        rules: input.rules_path.clone(),
         main_tree: "MainTree".into(),
         root,
         trees,
