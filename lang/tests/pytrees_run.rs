@@ -8,8 +8,8 @@
 use btc_emit::pytrees;
 use btc_ir::{ControlKind, DecoratorKind};
 use btc_ir::{
-    LeafKind, Node, NodeModel, Port, PortDirection, PortModel, PortValue, StepInfo, TreeDef,
-    TreeIr, IR_VERSION,
+    Label, LabelPart, LeafKind, Node, NodeModel, Port, PortDirection, PortModel, PortValue,
+    StepInfo, TreeDef, TreeIr, IR_VERSION,
 };
 use btc_lang::db::{compile, CompileJob, Database};
 use btc_pddl::logic::{name, Atom, Effect, Formula, InitFact, Signature, Term, TypedVar};
@@ -373,7 +373,13 @@ fn hostile_ir() -> TreeIr {
         params: vec!["x".into()],
         root: Node::Control {
             control: ControlKind::ReactiveSequence,
-            name: Some("go to {x} \"\"\" '''\n\\ </div>".into()),
+            name: Some(Label {
+                parts: vec![
+                    LabelPart::Text("go to ".into()),
+                    LabelPart::Param("x".into()),
+                    LabelPart::Text(" \"\"\" '''\n\\ </div>".into()),
+                ],
+            }),
             children: vec![
                 leaf(
                     Condition,
