@@ -463,9 +463,21 @@ fn version_1_json_files_still_run() {
     );
 }
 
-/// The commands a run sends its controller: (step, command, args).
-fn commands(out: &Output) -> Vec<serde_json::Value> {
-    summary(out)["commands"]
+/// `btc run ARGS --controller --format json`, which must exit 0: the
+/// commands it sends its controller, as (step, command, args).
+fn commands_of(args: &[&str], what: &str) -> Vec<serde_json::Value> {
+    let mut all = args.to_vec();
+    all.extend(["--controller", "--format", "json"]);
+    let out = btc(&all);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{what}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let s = summary(&out);
+    assert_eq!(s["goal_reached"], true, "{what}");
+    s["commands"]
         .as_array()
         .expect("a controller run lists its commands")
         .iter()
@@ -482,17 +494,7 @@ fn computed_values_reach_the_engine_from_the_ir_and_from_the_xml() {
     let rules = "tests/fixtures/emit/values/rules.btrules";
     let plan = "tests/fixtures/emit/values/plan.txt";
     let problem = "tests/fixtures/emit/values/problem.pddl";
-    let direct = btc(&[
-        "run",
-        rules,
-        "--plan",
-        plan,
-        "--controller",
-        "--format",
-        "json",
-    ]);
-    assert_eq!(direct.status.code(), Some(0));
-    let expected = commands(&direct);
+    let expected = commands_of(&["run", rules, "--plan", plan], "rules");
     let say: Vec<&serde_json::Value> = expected.iter().filter(|c| c[1] == "Say").collect();
     assert_eq!(
         say.iter().map(|c| c[2].clone()).collect::<Vec<_>>(),
@@ -524,23 +526,16 @@ fn computed_values_reach_the_engine_from_the_ir_and_from_the_xml() {
         ];
         args.extend(extra);
         assert_eq!(btc(&args).status.code(), Some(0), "{what}");
-        let out = btc(&[
-            "run",
-            "--tree",
-            tree.to_str().unwrap(),
-            "--problem",
-            problem,
-            "--controller",
-            "--format",
-            "json",
-        ]);
-        assert_eq!(
-            out.status.code(),
-            Some(0),
-            "{what}: {}",
-            String::from_utf8_lossy(&out.stderr)
+        let got = commands_of(
+            &[
+                "run",
+                "--tree",
+                tree.to_str().unwrap(),
+                "--problem",
+                problem,
+            ],
+            what,
         );
-        assert_eq!(summary(&out)["goal_reached"], true, "{what}");
-        assert_eq!(commands(&out), expected, "{what}");
+        assert_eq!(got, expected, "{what}");
     }
 }
