@@ -228,11 +228,12 @@ pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
         return Ok(ExitCode::from(1));
     };
     let text = match (&a.output, a.emit) {
-        // A JSON IR records its PDDL files relative to itself.
+        // A JSON IR records the files it was compiled from relative to
+        // its own folder.
         (Some(out), Output::Tree(f @ emit::Format::Json)) => {
             let mut ir = ir.clone();
             let dir = out.parent().unwrap_or(Path::new(""));
-            for p in [&mut ir.domain, &mut ir.problem] {
+            for p in [&mut ir.domain, &mut ir.problem, &mut ir.plan, &mut ir.rules] {
                 *p = crate::paths::text(&crate::paths::relative_to(Path::new(p.as_str()), dir));
             }
             emit::emit(&ir, f, &a.options)

@@ -85,6 +85,18 @@ fn rule_sets() -> Vec<RuleSet> {
         problem: repo().join("examples/ariac/problem.pddl"),
         ticks: vec![],
     });
+    // Values computed per step (table lookups passed to a tree, strings
+    // interpolating them) as ports of SubTree calls.
+    let values = repo().join("tests/fixtures/emit/values");
+    sets.push(RuleSet {
+        name: "values".into(),
+        rules: values.join("rules.btrules"),
+        jobs: vec![Job {
+            plan: values.join("plan.txt"),
+            problem: values.join("problem.pddl"),
+            ticks: vec![0, 3],
+        }],
+    });
     let workshop = repo().join("lang/tests/fixtures/pytrees/workshop");
     for arrangement in ["in_order", "backchained", "parallel"] {
         sets.push(RuleSet {

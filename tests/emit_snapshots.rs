@@ -63,3 +63,80 @@ fn every_example_with_every_emitter() {
         insta::assert_snapshot!("btcpp_inline", compile(rel, "btcpp", &["--inline"]));
     });
 }
+
+/// Fixtures for what a rules file says about names and values: each folder
+/// of `tests/fixtures/emit/` through every emitter like the examples,
+/// snapshots named after the folder.
+#[test]
+fn every_emit_fixture_with_every_emitter() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/emit");
+    let mut dirs: Vec<String> = std::fs::read_dir(&root)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    dirs.sort();
+    assert!(!dirs.is_empty(), "no fixture under {}", root.display());
+    for dir in dirs {
+        let rules = format!("tests/fixtures/emit/{dir}/rules.btrules");
+        let rules = Path::new(&rules);
+        for emit in EMITTERS {
+            insta::assert_snapshot!(format!("{dir}_{emit}"), compile(rules, emit, &[]));
+        }
+        insta::assert_snapshot!(
+            format!("{dir}_btcpp_inline"),
+            compile(rules, "btcpp", &["--inline"])
+        );
+    }
+}
+
+/// `name="..."` attribute values of an XML text.
+fn name_attributes(xml: &str) -> Vec<&str> {
+    xml.split(" name=\"")
+        .skip(1)
+        .map(|rest| &rest[..rest.find('"').unwrap_or(rest.len())])
+        .collect()
+}
+
+/// BT.CPP has no interpolation in `name`, and Groot2 shows it as written:
+/// no `{...}` may reach a name in either mode, and every value a step
+/// computes (a table lookup passed to a tree, an interpolation of it)
+/// arrives filled in.
+#[test]
+fn no_placeholder_reaches_a_btcpp_name_and_no_value_is_lost() {
+    let rules = Path::new("tests/fixtures/emit/values/rules.btrules");
+    for extra in [&[][..], &["--inline"][..]] {
+        let xml = compile(rules, "btcpp", extra);
+        for name in name_attributes(&xml) {
+            assert!(
+                !name.contains('{') && !name.contains('}'),
+                "{extra:?}: name=\"{name}\""
+            );
+        }
+        for line in xml.lines().filter(|l| !l.contains("<KbStep")) {
+            assert!(!line.contains("=\"\""), "{extra:?}: an empty port: {line}");
+        }
+        assert!(
+            xml.contains("holding battery_red at 5 N"),
+            "{extra:?}\n{xml}"
+        );
+        assert!(xml.contains("tray_gripper"), "{extra:?}\n{xml}");
+    }
+    let xml = compile(rules, "btcpp", &[]);
+    assert!(
+        xml.contains(r#"<Sequence name="pick ?p with ?gripper">"#),
+        "{xml}"
+    );
+    let inline = compile(rules, "btcpp", &["--inline"]);
+    assert!(
+        inline.contains(r#"<Sequence name="pick pump_blue with tray_gripper">"#),
+        "{inline}"
+    );
+    for emit in ["mermaid", "dot"] {
+        let text = compile(rules, emit, &[]);
+        assert!(
+            text.contains("pick battery_red with part_gripper"),
+            "{text}"
+        );
+        assert!(!text.contains("{newtons}"), "{text}");
+    }
+}

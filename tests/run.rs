@@ -371,6 +371,16 @@ fn a_json_ir_carries_its_world_and_runs_from_its_own_folder() {
         "{domain}"
     );
     assert!(out_dir.join(domain).is_file(), "{domain}");
+    // So are the problem, the plan and the rules file.
+    for key in ["problem", "plan", "rules"] {
+        let p = ir[key].as_str().unwrap_or_else(|| panic!("no {key}"));
+        assert!(!p.starts_with('/') && !p.contains("//"), "{key}: {p}");
+        assert!(out_dir.join(p).is_file(), "{key}: {p}");
+    }
+    assert!(ir["plan"]
+        .as_str()
+        .unwrap()
+        .ends_with("examples/ariac/plan.txt"));
     // `cd out && btc run --tree p01.json`: no PDDL file needed.
     let out = btc_in(&out_dir, &["run", "--tree", "p01.json", "--format", "json"]);
     assert_eq!(
@@ -441,4 +451,81 @@ fn version_1_json_files_still_run() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+}
+
+/// `btc run ARGS --controller --format json`, which must exit 0: the
+/// commands it sends its controller, as (step, command, args).
+fn commands_of(args: &[&str], what: &str) -> Vec<serde_json::Value> {
+    let mut all = args.to_vec();
+    all.extend(["--controller", "--format", "json"]);
+    let out = btc(&all);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{what}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let s = summary(&out);
+    assert_eq!(s["goal_reached"], true, "{what}");
+    s["commands"]
+        .as_array()
+        .expect("a controller run lists its commands")
+        .iter()
+        .map(|c| serde_json::json!([c["step"], c["command"], c["args"]]))
+        .collect()
+}
+
+/// Every value a step computes (table lookups passed to a tree, strings
+/// interpolating them) reaches btc's engine the same way from the rules,
+/// from the JSON IR, and from the BT.CPP XML in SubTree mode and inlined.
+#[test]
+fn computed_values_reach_the_engine_from_the_ir_and_from_the_xml() {
+    let dir = tempfile::tempdir().unwrap();
+    let rules = "tests/fixtures/emit/values/rules.btrules";
+    let plan = "tests/fixtures/emit/values/plan.txt";
+    let problem = "tests/fixtures/emit/values/problem.pddl";
+    let expected = commands_of(&["run", rules, "--plan", plan], "rules");
+    let say: Vec<&serde_json::Value> = expected.iter().filter(|c| c[1] == "Say").collect();
+    assert_eq!(
+        say.iter().map(|c| c[2].clone()).collect::<Vec<_>>(),
+        [
+            serde_json::json!([["text", "holding battery_red at 5 N"]]),
+            serde_json::json!([["text", "holding pump_blue at 8 N"]]),
+        ]
+    );
+    assert!(expected.contains(&serde_json::json!([
+        6,
+        "ChangeGripper",
+        [["robot", "floor_robot"], ["gripper", "tray_gripper"]]
+    ])));
+    for (what, emit, extra) in [
+        ("json", "json", None),
+        ("xml", "btcpp", None),
+        ("inlined xml", "btcpp", Some("--inline")),
+    ] {
+        let tree = dir.path().join(format!("tree_{emit}_{}", extra.is_some()));
+        let mut args = vec![
+            "compile",
+            rules,
+            "--plan",
+            plan,
+            "--emit",
+            emit,
+            "-o",
+            tree.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        assert_eq!(btc(&args).status.code(), Some(0), "{what}");
+        let got = commands_of(
+            &[
+                "run",
+                "--tree",
+                tree.to_str().unwrap(),
+                "--problem",
+                problem,
+            ],
+            what,
+        );
+        assert_eq!(got, expected, "{what}");
+    }
 }

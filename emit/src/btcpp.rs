@@ -146,9 +146,12 @@ impl Xml {
         self
     }
 
-    fn name(&mut self, name: &Option<String>) -> &mut Xml {
+    /// A node's `name`: BT.CPP has no interpolation in names, so a part
+    /// that a call fills in is written `?param`, the subtree port that
+    /// carries its value (inlined trees have every part filled).
+    fn name(&mut self, name: &Option<Label>) -> &mut Xml {
         if let Some(n) = name {
-            self.attr("name", n);
+            self.attr_display("name", Some(n));
         }
         self
     }

@@ -28,12 +28,14 @@ fn decorator_label(d: &DecoratorKind) -> String {
     }
 }
 
-fn leaf_label(id: &str, name: &Option<String>, ports: &[Port]) -> String {
+fn leaf_label(id: &str, name: &Option<Label>, ports: &[Port]) -> String {
     let args: Vec<String> = ports
         .iter()
         .map(|p| format!("{}: {}", p.name, p.value.to_text()))
         .collect();
-    let head = name.clone().unwrap_or_else(|| id.to_owned());
+    let head = name
+        .as_ref()
+        .map_or_else(|| id.to_owned(), Label::to_string);
     if args.is_empty() {
         head
     } else {

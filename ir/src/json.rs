@@ -82,6 +82,8 @@ impl V1 {
             version: IR_VERSION,
             domain: self.domain,
             problem: self.problem,
+            plan: String::new(),
+            rules: String::new(),
             main_tree: self.main_tree,
             root: upgrade_node(self.root)?,
             trees: self

@@ -15,7 +15,9 @@ use serde::{Deserialize, Serialize};
 use std::collections::HashSet;
 
 pub mod json;
+mod label;
 mod nodes;
+pub use label::{Label, LabelPart};
 pub use nodes::{ControlKind, Count, DecoratorKind};
 
 /// The version of the IR's JSON encoding (`"ir_version"`). Version 1 (PDDL
@@ -79,18 +81,18 @@ pub enum LeafKind {
 pub enum Node {
     Control {
         control: ControlKind,
-        name: Option<String>,
+        name: Option<Label>,
         children: Vec<Node>,
     },
     Decorator {
         decorator: DecoratorKind,
-        name: Option<String>,
+        name: Option<Label>,
         child: Box<Node>,
     },
     Leaf {
         leaf: LeafKind,
         id: String,
-        name: Option<String>,
+        name: Option<Label>,
         ports: Vec<Port>,
     },
     /// A call of a [`TreeDef`].
@@ -210,10 +212,18 @@ impl StepInfo {
 pub struct TreeIr {
     #[serde(rename = "ir_version")]
     pub version: u32,
-    /// The PDDL files it was compiled from (relative to the JSON file when
-    /// written with `-o`); informative: the world is [`TreeIr::world`].
+    /// The PDDL files it was compiled from (relative to the JSON file's
+    /// folder when written with `-o`); informative: the world is
+    /// [`TreeIr::world`].
     pub domain: String,
     pub problem: String,
+    /// The plan and the rules file it was compiled from, recorded like the
+    /// PDDL files; empty (and left out of the JSON) in files written before
+    /// btc recorded them.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub plan: String,
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub rules: String,
     pub main_tree: String,
     pub root: Node,
     pub trees: Vec<TreeDef>,
@@ -326,7 +336,7 @@ impl TreeIr {
                 children,
             } => Node::Control {
                 control: *control,
-                name: name.as_ref().map(|s| interpolate(s, args)),
+                name: name.as_ref().map(|s| s.fill(args)),
                 children: children
                     .iter()
                     .map(|c| self.inline_node(c, args, depth, only))
@@ -344,7 +354,7 @@ impl TreeIr {
                     },
                     _ => decorator.clone(),
                 },
-                name: name.as_ref().map(|s| interpolate(s, args)),
+                name: name.as_ref().map(|s| s.fill(args)),
                 child: Box::new(self.inline_node(child, args, depth, only)),
             },
             Node::Leaf {
@@ -355,7 +365,7 @@ impl TreeIr {
             } => Node::Leaf {
                 leaf: *leaf,
                 id: id.clone(),
-                name: name.as_ref().map(|s| interpolate(s, args)),
+                name: name.as_ref().map(|s| s.fill(args)),
                 ports: subst(ports),
             },
             Node::Step { step, child } => Node::Step {
@@ -394,13 +404,4 @@ fn count_of(param: &str, args: &[Port]) -> Option<Count> {
         PortValue::Param(p) => Some(Count::Param { param: p.clone() }),
         _ => None,
     }
-}
-
-/// Fills `{param}` in a node name from the call's arguments.
-fn interpolate(s: &str, args: &[Port]) -> String {
-    let mut out = s.to_owned();
-    for a in args {
-        out = out.replace(&format!("{{{}}}", a.name), &a.value.to_text());
-    }
-    out
 }

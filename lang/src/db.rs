@@ -899,6 +899,8 @@ pub fn compile(db: &dyn Db, job: CompileJob) -> Result<btc_ir::TreeIr, Vec<Diagn
         steps: &tp.steps,
         domain_path: d.path(db).clone(),
         problem_path: p.path(db).clone(),
+        plan_path: job.plan(db).path(db).clone(),
+        rules_path: rules.path(db).clone(),
     };
     crate::lower::lower(&input)
 }

@@ -38,6 +38,8 @@ pub struct LowerInput<'a> {
     pub steps: &'a [GroundStep],
     pub domain_path: String,
     pub problem_path: String,
+    pub plan_path: String,
+    pub rules_path: String,
 }
 
 struct Types<'a> {
@@ -124,7 +126,10 @@ fn expand_tree(decl: &TreeDecl, args: &[Arg]) -> Vec<Template> {
                     Some(Value::Bool { value, .. }) => parts.push(StrPart::Text {
                         text: value.to_string(),
                     }),
-                    Some(Value::Lookup { .. }) | None => parts.push(p.clone()),
+                    Some(v @ Value::Lookup { .. }) => parts.push(StrPart::Value {
+                        value: Box::new(v.clone()),
+                    }),
+                    None => parts.push(p.clone()),
                 },
                 other => parts.push(other.clone()),
             }
@@ -298,29 +303,47 @@ impl Inst<'_> {
                         out.push('}');
                     }
                 },
+                StrPart::Value { value } => out.push_str(&self.eval(value).to_text()),
             }
         }
         out
     }
 
-    /// A node name: interpolations become `{param}` in parametric mode (the
-    /// inliner fills them), values otherwise.
-    fn name(&mut self, s: &Option<StrLit>) -> Option<String> {
+    /// A node name. In a rule's parametric tree, each part that depends on
+    /// the step becomes a parameter of the tree (each call fills it in);
+    /// otherwise every part is the step's value.
+    fn name(&mut self, s: &Option<StrLit>) -> Option<Label> {
         let s = s.as_ref()?;
-        if self.params.is_some() && self.tree_ports.is_empty() {
-            for p in &s.parts {
-                match p {
-                    StrPart::Var { name } => {
-                        self.param_for(&Value::Var { name: name.clone() }, &name.text);
-                    }
-                    StrPart::Capture { name } => {
-                        self.param_for(&Value::Name { name: name.clone() }, &name.text);
-                    }
-                    StrPart::Text { .. } => {}
+        let parametric = self.params.is_some() && self.tree_ports.is_empty();
+        let mut label = Label { parts: Vec::new() };
+        for p in &s.parts {
+            let v = match p {
+                StrPart::Text { text } => {
+                    label.push_text(text);
+                    continue;
                 }
+                StrPart::Var { name } => Value::Var { name: name.clone() },
+                StrPart::Capture { name } => Value::Name { name: name.clone() },
+                StrPart::Value { value } => (**value).clone(),
+            };
+            let preferred = match &v {
+                Value::Var { name } | Value::Name { name } => name.text.clone(),
+                Value::Lookup { table, .. } => table.text.clone(),
+                _ => "name".to_owned(),
+            };
+            match if parametric && Self::depends_on_step(&v) {
+                self.param_for(&v, &preferred)
+            } else {
+                self.eval(&v)
+            } {
+                PortValue::Param(p) => label.parts.push(LabelPart::Param(p)),
+                other => label.push_text(&other.to_text()),
             }
         }
-        Some(self.string(s))
+        if label.parts.is_empty() {
+            label.push_text("");
+        }
+        Some(label)
     }
 
     /// A decorator of the IR: its argument evaluated, or (in a rule's
@@ -474,6 +497,7 @@ fn value_key(v: &Value) -> String {
                     StrPart::Text { text } => format!("{text:?}"),
                     StrPart::Var { name } => format!("?{}", name.text),
                     StrPart::Capture { name } => format!("{{{}}}", name.text),
+                    StrPart::Value { value } => format!("{{{}}}", value_key(value)),
                 })
                 .collect();
             format!("string {}", parts.join(" "))
@@ -750,7 +774,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
         if let Some(over) = &info.pre_over_all {
             child = Node::Control {
                 control: ControlKind::ReactiveSequence,
-                name: Some(format!("while {over}")),
+                name: Some(format!("while {over}").into()),
                 children: vec![kb_holds(over.clone(), None), child],
             };
         }
@@ -849,6 +873,8 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
         version: IR_VERSION,
         domain: input.domain_path.clone(),
         problem: input.problem_path.clone(),
+        plan: input.plan_path.clone(),
+        rules: input.rules_path.clone(),
         main_tree: "MainTree".into(),
         root,
         trees,

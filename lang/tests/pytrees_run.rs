@@ -8,8 +8,8 @@
 use btc_emit::pytrees::{self, PyOptions};
 use btc_ir::{ControlKind, DecoratorKind};
 use btc_ir::{
-    LeafKind, Node, NodeModel, Port, PortDirection, PortModel, PortValue, StepInfo, TreeDef,
-    TreeIr, IR_VERSION,
+    Label, LabelPart, LeafKind, Node, NodeModel, Port, PortDirection, PortModel, PortValue,
+    StepInfo, TreeDef, TreeIr, IR_VERSION,
 };
 use btc_lang::db::{compile, CompileJob, Database};
 use btc_pddl::logic::{name, Atom, Effect, Formula, InitFact, Signature, Term, TypedVar};
@@ -425,7 +425,13 @@ fn hostile_ir() -> TreeIr {
         params: vec!["x".into()],
         root: Node::Control {
             control: ControlKind::ReactiveSequence,
-            name: Some("go to {x} \"\"\" '''\n\\ </div>".into()),
+            name: Some(Label {
+                parts: vec![
+                    LabelPart::Text("go to ".into()),
+                    LabelPart::Param("x".into()),
+                    LabelPart::Text(" \"\"\" '''\n\\ </div>".into()),
+                ],
+            }),
             children: vec![
                 leaf(
                     Condition,
@@ -510,6 +516,8 @@ fn hostile_ir() -> TreeIr {
         version: IR_VERSION,
         domain: "dom\"\"\"ain\n'''\\.pddl".into(),
         problem: "prob\nimport os; os.system('false')\n#".into(),
+        plan: String::new(),
+        rules: String::new(),
         main_tree: "Main\"Tree".into(),
         root: Node::Control {
             control: ControlKind::Sequence,
@@ -790,4 +798,28 @@ fn corpus_plans_run_to_success() {
         }
     }
     assert!(ran >= 12, "only {ran} corpus plans");
+}
+
+/// The values a step computes (table lookups passed to a tree, strings that
+/// interpolate them) reach the module's behaviours, and it runs to the goal
+/// under real py_trees (`tests/fixtures/emit/values`).
+#[test]
+fn computed_values_reach_the_module() {
+    if !btc_testkit::py_trees() {
+        return;
+    }
+    let ir = compile_dir(
+        &repo_root().join("tests/fixtures/emit/values"),
+        "rules.btrules",
+    );
+    let text = emit_and_run(&ir, "values");
+    for expected in [
+        r#"Say("Say", text="holding battery_red at 5 N")"#,
+        r#"Say("Say", text="holding pump_blue at 8 N")"#,
+        r#"gripper="tray_gripper""#,
+        r#"name="pick pump_blue with tray_gripper""#,
+        r#"name="pick a PUMP""#,
+    ] {
+        assert!(text.contains(expected), "no {expected}\n{text}");
+    }
 }

@@ -183,7 +183,7 @@ pub fn from_node(n: &Node) -> SNode {
                     failure: clamp(*failure),
                 },
             },
-            name.clone(),
+            name.as_ref().map(ToString::to_string),
             children.iter().map(from_node).collect(),
         ),
         Node::Decorator {
@@ -199,7 +199,7 @@ pub fn from_node(n: &Node) -> SNode {
                 DecoratorKind::ForceSuccess => Kind::ForceSuccess,
                 DecoratorKind::ForceFailure => Kind::ForceFailure,
             },
-            name.clone(),
+            name.as_ref().map(ToString::to_string),
             vec![from_node(child)],
         ),
         Node::Leaf {
@@ -213,7 +213,7 @@ pub fn from_node(n: &Node) -> SNode {
                 kind: Some(*leaf),
                 ports: ports(ps),
             },
-            name.clone(),
+            name.as_ref().map(ToString::to_string),
             Vec::new(),
         ),
         Node::SubTree { id, ports: ps } => (

@@ -18,7 +18,7 @@ mod encode;
 pub mod names;
 
 use btc_ir::{ControlKind, Count, DecoratorKind};
-use btc_ir::{LeafKind, Node, NodeModel, Port, StepInfo, TreeIr};
+use btc_ir::{Label, LeafKind, Node, NodeModel, Port, StepInfo, TreeIr};
 use btc_pddl::logic::InitFact;
 use names::{is_plain_kwarg, RESERVED};
 pub use names::{push_py_str, py_ident, py_str, Names};
@@ -552,8 +552,9 @@ fn push_indent(o: &mut String, levels: usize) {
     }
 }
 
-fn opt_name(name: &Option<String>) -> String {
-    name.as_deref().map_or_else(|| "None".into(), py_str)
+fn opt_name(name: &Option<Label>) -> String {
+    name.as_ref()
+        .map_or_else(|| "None".into(), |n| py_str(&n.to_string()))
 }
 
 /// `(("port", value), ...)`

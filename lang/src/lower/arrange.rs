@@ -13,7 +13,7 @@ pub(super) fn kb_holds(f: Formula, name: Option<String>) -> Node {
     Node::Leaf {
         leaf: LeafKind::Condition,
         id: "KbHolds".into(),
-        name,
+        name: name.map(Label::text),
         ports: vec![Port {
             name: "formula".into(),
             value: PortValue::Formula(f),
@@ -108,7 +108,7 @@ pub(super) fn parallel(step_nodes: &[Option<Node>], infos: &[StepInfo]) -> Node 
                         seq.push(Node::Leaf {
                             leaf: LeafKind::Action,
                             id: "WaitForStep".into(),
-                            name: Some(format!("wait for step {}", i + 1)),
+                            name: Some(format!("wait for step {}", i + 1).into()),
                             ports: vec![Port {
                                 name: "step".into(),
                                 value: PortValue::Int(i as i64 + 1),

@@ -311,7 +311,7 @@ pub(super) fn stages(
         }
         out.push(Node::Control {
             control: ControlKind::Fallback,
-            name: Some(format!("step {label} {}", info.display())),
+            name: Some(format!("step {label} {}", info.display()).into()),
             children: vec![
                 kb_holds(not_needed, Some(format!("step {label} not needed?"))),
                 Node::Control {

@@ -43,6 +43,13 @@ pub enum StrPart {
     Capture {
         name: Ident,
     },
+    /// A value spliced in where a `tree`'s string interpolates a port that
+    /// its call gives a value with no text of its own yet (a table
+    /// lookup). Never parsed: lowering puts it in when it expands the call,
+    /// so it is evaluated per step like any other part.
+    Value {
+        value: Box<Value>,
+    },
 }
 
 /// A string literal, split at its `{...}` interpolations.

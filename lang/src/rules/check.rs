@@ -416,7 +416,8 @@ impl Tcx<'_> {
                 StrPart::Capture { name } => {
                     self.capture(name);
                 }
-                StrPart::Text { .. } => {}
+                // Checked where the call that spliced it in wrote it.
+                StrPart::Text { .. } | StrPart::Value { .. } => {}
             }
         }
     }

@@ -380,6 +380,7 @@ pub fn string(s: &StrLit) -> String {
             }
             StrPart::Var { name } => out.push_str(&format!("{{?{}}}", name.text)),
             StrPart::Capture { name } => out.push_str(&format!("{{{}}}", name.text)),
+            StrPart::Value { value: v } => out.push_str(&format!("{{{}}}", value(v))),
         }
     }
     out.push('"');
