@@ -9,6 +9,7 @@
 //! After divan's table, `main` prints the per-leaf figures directly.
 
 use btc_ir::{LeafKind, PortValue};
+use btc_pddl::logic::decode;
 use btc_pddl::pipeline;
 use btc_runtime::spec::{Kind, SNode, TreeDoc};
 use btc_runtime::{xml, Engine, Kb, Options, Status};
@@ -146,7 +147,10 @@ fn reactive_kb_monitor_over_100_actions(b: Bencher) {
         Kind::Leaf {
             id: "KbHolds".into(),
             kind: None,
-            ports: vec![("formula".into(), PortValue::Text("(at r1 bin1)".into()))],
+            ports: vec![(
+                "formula".into(),
+                PortValue::Formula(decode::formula("(at r1 bin1)").unwrap()),
+            )],
         },
         Vec::new(),
     );

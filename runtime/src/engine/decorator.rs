@@ -1,0 +1,89 @@
+//! Decorators: one child, its status transformed (Inverter, ForceSuccess,
+//! ForceFailure, KeepRunningUntilFailure, and SubTree, which passes it
+//! through), repeated (Retry, Repeat) or bounded in time (Timeout).
+
+use super::record::Reason;
+use super::state::NodeState;
+use super::{Engine, NodeDef, Op, Status};
+
+impl<'w> Engine<'w> {
+    /// The decorators that map their child's status.
+    pub(super) fn tick_wrapper(&mut self, i: u32, def: NodeDef) -> Status {
+        self.set(i as usize, Status::Running);
+        let c = self.kid(def, 0);
+        let s = self.tick_node(c);
+        if s.is_done() {
+            self.reset(c);
+        }
+        match (def.op, s) {
+            (_, Status::Running) => Status::Running,
+            (Op::Inverter, Status::Success) => self.fail(i, "its child succeeded (Inverter)"),
+            (Op::Inverter, _) => Status::Success,
+            (Op::ForceSuccess, _) => Status::Success,
+            (Op::ForceFailure, _) => self.fail(i, "ForceFailure"),
+            (Op::KeepRunningUntilFailure, Status::Success) => Status::Running,
+            (_, s) => s,
+        }
+    }
+
+    /// Retry (`RETRY`) counts failures and stops at a success; Repeat
+    /// counts successes and stops at a failure. `n < 0`: forever.
+    pub(super) fn tick_loop<const RETRY: bool>(
+        &mut self,
+        iu: usize,
+        def: NodeDef,
+        n: i32,
+    ) -> Status {
+        self.set(iu, Status::Running);
+        let c = self.kid(def, 0);
+        let (again, end) = if RETRY {
+            (Status::Failure, Status::Success)
+        } else {
+            (Status::Success, Status::Failure)
+        };
+        loop {
+            let made = self.state[iu].attempts();
+            if !(n < 0 || (made as i64) < n as i64) {
+                self.state[iu] = NodeState::Fresh;
+                return again;
+            }
+            let s = self.tick_node(c);
+            if s == Status::Running {
+                return Status::Running;
+            }
+            self.reset(c);
+            if s == end {
+                self.state[iu] = NodeState::Fresh;
+                return end;
+            }
+            self.state[iu] = NodeState::Attempts(made.saturating_add(1));
+            if n < 0 {
+                // Forever: one attempt per tick, so a tick ends.
+                return Status::Running;
+            }
+        }
+    }
+
+    pub(super) fn tick_timeout(&mut self, i: u32, def: NodeDef, msec: u64) -> Status {
+        let iu = i as usize;
+        let c = self.kid(def, 0);
+        if self.status[iu] != Status::Running {
+            self.set(iu, Status::Running);
+            self.state[iu] = NodeState::Until(self.now_ms.saturating_add(msec));
+        }
+        if msec > 0
+            && self.now_ms >= self.state[iu].until()
+            && self.status[c as usize] == Status::Running
+        {
+            self.reset(c);
+            self.note_failure(i, Reason::Plain(format!("timed out after {msec} ms")));
+            Status::Failure
+        } else {
+            let s = self.tick_node(c);
+            if s.is_done() {
+                self.reset(c);
+            }
+            s
+        }
+    }
+}
