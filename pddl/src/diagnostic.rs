@@ -332,6 +332,8 @@ pub mod codes {
         X_REPLAN_UNSOLVABLE = "X008", "a goal that replanning cannot reach after a fault";
         X_REPLAN_LIMIT = "X009", "a closed loop that stopped at its replan or tick limit";
         X_WORLD = "X010", "a JSON IR whose world is missing or does not fit together";
+        X_SCRIPT = "X040", "a BT.CPP script that does not parse";
+        X_UNSUPPORTED = "X041", "a BT.CPP XML construct btc does not run";
         // ARIAC trials (btc trial)
         TRIAL_SYNTAX = "T001", "a trial file that is not YAML btc reads";
         TRIAL_MISSING = "T002", "a trial field the ARIAC 2023 format requires is missing";

@@ -14,6 +14,7 @@ pub mod engine;
 pub mod error;
 pub mod faults;
 pub mod kb;
+pub mod script;
 pub mod spec;
 pub mod xml;
 

@@ -7,9 +7,9 @@
 
 use crate::engine::MAX_DEPTH;
 use crate::error::LoadError;
-use crate::spec::{Kind, SNode, TreeDoc};
+use crate::spec::{Kind, NodeScripts, SNode, TreeDoc, Verdict};
 use btc_ir::{LeafKind, NodeModel, PortDirection, PortModel, PortValue};
-use btc_pddl::diagnostic::codes;
+use btc_pddl::diagnostic::{codes, did_you_mean};
 use btc_pddl::logic::decode;
 use quick_xml::events::{BytesStart, Event};
 use quick_xml::Reader;
@@ -97,8 +97,61 @@ fn ports(e: &mut Elem, skip: &[&str]) -> Vec<(String, PortValue)> {
         .collect()
 }
 
+/// The pre- and post-condition attributes (`_skipIf`...), moved out; any
+/// other attribute starting with `_` but `_autoremap` is refused (X041).
+fn node_scripts(e: &mut Elem) -> Result<NodeScripts, LoadError> {
+    let mut scripts = NodeScripts::default();
+    let mut rest = Vec::with_capacity(e.attrs.len());
+    for (k, v) in std::mem::take(&mut e.attrs) {
+        match NodeScripts::ATTRIBUTES.iter().position(|a| *a == k) {
+            Some(i) => *scripts.slot(i) = Some(v),
+            None if k.starts_with('_') && k != "_autoremap" => {
+                let known = NodeScripts::ATTRIBUTES
+                    .iter()
+                    .copied()
+                    .chain(["_autoremap"]);
+                let mut err = LoadError::new(
+                    codes::X_UNSUPPORTED,
+                    format!("<{}>: the attribute `{k}` is not one btc runs", e.name),
+                )
+                .at(e.at);
+                err = err.hint(match did_you_mean(&k, known) {
+                    Some(h) => h,
+                    None => "btc runs the pre- and post-conditions `_failureIf`, `_successIf`, `_skipIf`, `_while`, `_onSuccess`, `_onFailure`, `_post` and `_onHalted`, and SubTree's `_autoremap`".into(),
+                });
+                return Err(err);
+            }
+            None => rest.push((k, v)),
+        }
+    }
+    e.attrs = rest;
+    Ok(scripts)
+}
+
+/// A status named in an attribute (`Precondition`'s `else`).
+fn verdict(e: &Elem, key: &str, default: Verdict) -> Result<Verdict, LoadError> {
+    Ok(match e.get(key).map(str::trim) {
+        None => default,
+        Some("SUCCESS") => Verdict::Success,
+        Some("FAILURE") => Verdict::Failure,
+        Some("SKIPPED") => Verdict::Skipped,
+        Some("RUNNING") => Verdict::Running,
+        Some(v) => {
+            return Err(LoadError::new(
+                codes::X_BAD_PORT,
+                format!(
+                    "<{}>: `{key}=\"{v}\"` is not SUCCESS, FAILURE, SKIPPED or RUNNING",
+                    e.name
+                ),
+            )
+            .at(e.at))
+        }
+    })
+}
+
 fn node_of(mut e: Elem) -> Result<SNode, LoadError> {
     let name = e.get("name").map(str::to_owned);
+    let scripts = node_scripts(&mut e)?;
     let kind = match e.name.as_str() {
         "Sequence" => Kind::Sequence,
         "ReactiveSequence" => Kind::ReactiveSequence,
@@ -121,6 +174,60 @@ fn node_of(mut e: Elem) -> Result<SNode, LoadError> {
                 LoadError::new(codes::X_BAD_PORT, "<Timeout>: `msec` must not be negative").at(e.at)
             })?)
         }
+        "IfThenElse" => Kind::IfThenElse,
+        "WhileDoElse" => Kind::WhileDoElse,
+        "Switch2" | "Switch3" | "Switch4" | "Switch5" | "Switch6" => {
+            let n: usize = e.name["Switch".len()..].parse().unwrap_or(2);
+            let variable = e.get("variable").map(|v| port_value(v.to_owned()));
+            let variable = variable.ok_or_else(|| {
+                LoadError::new(
+                    codes::X_BAD_PORT,
+                    format!("<{}> needs the attribute `variable`", e.name),
+                )
+                .at(e.at)
+            })?;
+            let cases = (1..=n)
+                .map(|k| {
+                    e.get(&format!("case_{k}"))
+                        .map(|v| port_value(v.to_owned()))
+                        .unwrap_or(PortValue::Text(String::new()))
+                })
+                .collect();
+            Kind::Switch { variable, cases }
+        }
+        "Delay" => {
+            let ms = e.int("delay_msec", None)?;
+            Kind::Delay(u64::try_from(ms).map_err(|_| {
+                LoadError::new(
+                    codes::X_BAD_PORT,
+                    "<Delay>: `delay_msec` must not be negative",
+                )
+                .at(e.at)
+            })?)
+        }
+        "RunOnce" => Kind::RunOnce {
+            then_skip: match e.get("then_skip").map(str::trim) {
+                None | Some("true") | Some("1") => true,
+                Some("false") | Some("0") => false,
+                Some(v) => {
+                    return Err(LoadError::new(
+                        codes::X_BAD_PORT,
+                        format!("<RunOnce>: `then_skip=\"{v}\"` is not true or false"),
+                    )
+                    .at(e.at))
+                }
+            },
+        },
+        "Precondition" => Kind::Precondition {
+            code: e
+                .get("if")
+                .ok_or_else(|| {
+                    LoadError::new(codes::X_BAD_PORT, "<Precondition> needs the attribute `if`")
+                        .at(e.at)
+                })?
+                .to_owned(),
+            otherwise: verdict(&e, "else", Verdict::Failure)?,
+        },
         "SubTree" => {
             let id = e.get("ID").ok_or_else(|| {
                 LoadError::new(codes::X_BAD_PORT, "<SubTree> needs the attribute `ID`").at(e.at)
@@ -186,6 +293,7 @@ fn node_of(mut e: Elem) -> Result<SNode, LoadError> {
         kind,
         name,
         children: Vec::new(),
+        scripts,
         at: Some(e.at),
     })
 }

@@ -4,13 +4,15 @@
 //! and the KB's formulas and effects are compiled once.
 
 use super::control::threshold;
+use super::guard::{CompiledScript, Guard};
 use super::state::NodeState;
 use super::step::StepRt;
+use super::NO_GUARD;
 use super::{ActionInfo, CondInfo, Engine, NodeDef, NodeMeta, Op, Options, PortBind, Src, Status};
 use super::{Value, MAX_CALLS, MAX_DEPTH};
 use crate::error::LoadError;
 use crate::kb::{ConditionId, EffectId, FormulaId, Kb};
-use crate::spec::{default_name, Kind, SNode, TreeDoc};
+use crate::spec::{default_name, Kind, NodeScripts, SNode, TreeDoc, Verdict};
 use btc_ir::{LeafKind, NodeModel, PortValue};
 use btc_pddl::diagnostic::{codes, did_you_mean};
 use btc_pddl::logic::{self, Binding, Effect, Formula, Name, Terms};
@@ -48,6 +50,8 @@ impl<'w> Engine<'w> {
             ports: Vec::new(),
             actions: Vec::new(),
             conds: Vec::new(),
+            scripts: Vec::new(),
+            guards: Vec::new(),
             slot_names: Vec::new(),
             bb: Vec::new(),
             bb_gen: 1,
@@ -197,6 +201,8 @@ const BUILTIN_LEAVES: &[&str] = &[
     "KbHolds",
     "KbApply",
     "WaitForStep",
+    "Script",
+    "ScriptCondition",
 ];
 
 impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
@@ -232,6 +238,7 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
             op: Op::AlwaysSuccess,
             first: 0,
             len: 0,
+            guard: NO_GUARD,
         });
         self.e.meta.push(NodeMeta {
             id: String::new(),
@@ -239,13 +246,18 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
             step,
             parent,
         });
-        let arity = |want: usize, b: &Self| -> Result<(), LoadError> {
-            if n.children.len() != want {
+        let arity = |want: &[usize], b: &Self| -> Result<(), LoadError> {
+            if !want.contains(&n.children.len()) {
+                let takes = match want {
+                    [1] => "exactly one child".to_owned(),
+                    [a, b] => format!("{a} or {b} children"),
+                    _ => format!("{} children", want[0]),
+                };
                 return Err(b.err(
                     codes::X_BAD_PORT,
                     n,
                     format!(
-                        "`{}` takes exactly one child, and has {}",
+                        "`{}` takes {takes}, and has {}",
                         default_name(&n.kind),
                         n.children.len()
                     ),
@@ -286,6 +298,40 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
             Kind::Retry(k) => Op::Retry(*k),
             Kind::Repeat(k) => Op::Repeat(*k),
             Kind::Timeout(ms) => Op::Timeout(*ms),
+            Kind::IfThenElse => {
+                arity(&[2, 3], self)?;
+                Op::IfThenElse
+            }
+            Kind::WhileDoElse => {
+                arity(&[2, 3], self)?;
+                Op::WhileDoElse
+            }
+            Kind::Switch { variable, cases } => {
+                arity(&[cases.len() + 1], self)?;
+                let mut ports = vec![("variable".to_owned(), variable.clone())];
+                for (k, c) in cases.iter().enumerate() {
+                    ports.push((format!("case_{}", k + 1), c.clone()));
+                }
+                let (first, _) = self.bind_ports(n, &ports, &|_| None, scope)?;
+                Op::Switch {
+                    variable: first,
+                    first_case: first + 1,
+                    cases: cases.len() as u32,
+                }
+            }
+            Kind::Delay(ms) => Op::Delay(*ms),
+            Kind::RunOnce { then_skip } => Op::RunOnce {
+                then_skip: *then_skip,
+            },
+            Kind::Precondition { code, otherwise } => Op::Precondition {
+                script: self.script(n, "if", code, scope)?,
+                otherwise: match otherwise {
+                    Verdict::Success => Status::Success,
+                    Verdict::Failure => Status::Failure,
+                    Verdict::Skipped => Status::Skipped,
+                    Verdict::Running => Status::Running,
+                },
+            },
             Kind::SubTree { .. } => {
                 id = "SubTree".into();
                 Op::SubTree
@@ -357,9 +403,17 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
                 | Op::Repeat(_)
                 | Op::Timeout(_)
                 | Op::Step(_)
+                | Op::Delay(_)
+                | Op::RunOnce { .. }
+                | Op::Precondition { .. }
         ) {
-            arity(1, self)?;
+            arity(&[1], self)?;
         }
+        let guard = if n.scripts.is_empty() {
+            NO_GUARD
+        } else {
+            self.guard(n, scope)?
+        };
         {
             let m = &mut self.e.meta[me as usize];
             m.name = name;
@@ -431,7 +485,12 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
         let first = self.e.kids.len() as u32;
         let len = (self.pending.len() - mark) as u32;
         self.e.kids.extend(self.pending.drain(mark..));
-        self.e.nodes[me as usize] = NodeDef { op, first, len };
+        self.e.nodes[me as usize] = NodeDef {
+            op,
+            first,
+            len,
+            guard,
+        };
         Ok(me)
     }
 
@@ -484,6 +543,50 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
         st.pre_over_all = over_all;
         st.pre_end = pre_end;
         Ok(())
+    }
+
+    /// A script of node `n` (its attribute or port `what`), parsed, its
+    /// variables bound to blackboard slots of the scope.
+    fn script(
+        &mut self,
+        n: &SNode,
+        what: &str,
+        text: &str,
+        scope: &mut Scope,
+    ) -> Result<u32, LoadError> {
+        let script = crate::script::parse(text).map_err(|e| {
+            self.err(
+                codes::X_SCRIPT,
+                n,
+                format!("`{what}` of `{}`: {e}", default_name(&n.kind)),
+            )
+            .hint(format!("the script is `{text}`; BT.CPP's scripting language is described in docs/runtime.md"))
+        })?;
+        let slots = script.vars.iter().map(|v| self.slot_in(scope, v)).collect();
+        self.e.scripts.push(CompiledScript {
+            script,
+            slots,
+            text: text.into(),
+        });
+        Ok((self.e.scripts.len() - 1) as u32)
+    }
+
+    /// The pre- and post-condition scripts of node `n`.
+    fn guard(&mut self, n: &SNode, scope: &mut Scope) -> Result<u32, LoadError> {
+        let mut all = n.scripts.clone();
+        let mut g = Guard::default();
+        for (k, attr) in NodeScripts::ATTRIBUTES.iter().enumerate() {
+            if let Some(text) = all.slot(k).take() {
+                let id = self.script(n, attr, &text, scope)?;
+                if k < 4 {
+                    g.pre[k] = Some(id);
+                } else {
+                    g.post[k - 4] = Some(id);
+                }
+            }
+        }
+        self.e.guards.push(g);
+        Ok((self.e.guards.len() - 1) as u32)
     }
 
     fn slot_in(&mut self, scope: &mut Scope, key: &str) -> u32 {
@@ -645,6 +748,22 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
         let what = format!("`{id}`");
         match id {
             "AlwaysSuccess" => return Ok(Op::AlwaysSuccess),
+            "Script" | "ScriptCondition" => {
+                let code = self.const_text(n, ports, "code", true)?.unwrap_or_default();
+                if let Some((k, _)) = ports.iter().find(|(k, _)| k != "code") {
+                    return Err(self.err(
+                        codes::X_BAD_PORT,
+                        n,
+                        format!("`{id}` has no port `{k}`; its script is the port `code`"),
+                    ));
+                }
+                let k = self.script(n, "code", &code, scope)?;
+                return Ok(if id == "Script" {
+                    Op::Script(k)
+                } else {
+                    Op::ScriptCondition(k)
+                });
+            }
             "AlwaysFailure" => return Ok(Op::AlwaysFailure),
             "Sleep" => {
                 self.const_text(n, ports, "msec", true)?;

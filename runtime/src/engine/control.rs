@@ -9,7 +9,8 @@ impl<'w> Engine<'w> {
     /// node (else its failure does). `REACTIVE`: every tick starts from the
     /// first child, and a RUNNING child halts all the others. `MEMORY`: the
     /// child that ended the node is where the next tick starts
-    /// (SequenceWithMemory).
+    /// (SequenceWithMemory). SKIPPED children are passed over; when all
+    /// were, the node is SKIPPED.
     #[inline]
     pub(super) fn tick_ordered<const FALLBACK: bool, const REACTIVE: bool, const MEMORY: bool>(
         &mut self,
@@ -22,14 +23,23 @@ impl<'w> Engine<'w> {
             (Status::Failure, Status::Success)
         };
         self.set(iu, Status::Running);
-        let mut idx = if REACTIVE { 0 } else { self.state[iu].child() };
+        let (mut idx, mut skipped) = if REACTIVE {
+            (0, 0)
+        } else {
+            self.state[iu].child()
+        };
         loop {
             if idx >= def.len {
                 self.reset_children(def, 0);
                 self.state[iu] = NodeState::Fresh;
-                return done;
+                return if skipped == def.len {
+                    Status::Skipped
+                } else {
+                    done
+                };
             }
-            let s = self.tick_node(self.kid(def, idx));
+            let c = self.kid(def, idx);
+            let s = self.tick_node(c);
             if s == Status::Running {
                 if REACTIVE {
                     for k in (0..def.len).filter(|&k| k != idx) {
@@ -37,7 +47,7 @@ impl<'w> Engine<'w> {
                         self.reset(o);
                     }
                 } else {
-                    self.state[iu] = NodeState::Child(idx);
+                    self.state[iu] = NodeState::Child { next: idx, skipped };
                 }
                 return Status::Running;
             }
@@ -45,12 +55,19 @@ impl<'w> Engine<'w> {
                 if MEMORY {
                     // The index is kept: the child that ended it runs again.
                     self.reset_children(def, idx);
-                    self.state[iu] = NodeState::Child(idx);
+                    self.state[iu] = NodeState::Child { next: idx, skipped };
                 } else {
                     self.reset_children(def, 0);
                     self.state[iu] = NodeState::Fresh;
                 }
                 return stop;
+            }
+            if s == Status::Skipped {
+                skipped += 1;
+                if REACTIVE {
+                    // So that it can be skipped again.
+                    self.reset(c);
+                }
             }
             idx += 1;
         }
@@ -69,6 +86,7 @@ impl<'w> Engine<'w> {
         let need_f = threshold(failure, n);
         let (s0, f0) = self.state[iu].tally();
         let (mut succ, mut fail) = (s0 as i64, f0 as i64);
+        let mut skipped = 0;
         let mut out = Status::Running;
         for j in 0..def.len {
             let c = self.kid(def, j);
@@ -76,6 +94,7 @@ impl<'w> Engine<'w> {
                 match self.tick_node(c) {
                     Status::Success => succ += 1,
                     Status::Failure => fail += 1,
+                    Status::Skipped => skipped += 1,
                     _ => {}
                 }
             }
@@ -93,6 +112,9 @@ impl<'w> Engine<'w> {
                 success: succ as u32,
                 failure: fail as u32,
             };
+            if skipped == def.len {
+                return Status::Skipped;
+            }
         } else {
             self.state[iu] = NodeState::Fresh;
             self.reset_children(def, 0);

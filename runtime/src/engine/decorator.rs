@@ -17,6 +17,7 @@ impl<'w> Engine<'w> {
         }
         match (def.op, s) {
             (_, Status::Running) => Status::Running,
+            (_, Status::Skipped) => Status::Skipped,
             (Op::Inverter, Status::Success) => self.fail(i, "its child succeeded (Inverter)"),
             (Op::Inverter, _) => Status::Success,
             (Op::ForceSuccess, _) => Status::Success,
@@ -52,6 +53,10 @@ impl<'w> Engine<'w> {
                 return Status::Running;
             }
             self.reset(c);
+            if s == Status::Skipped {
+                self.state[iu] = NodeState::Fresh;
+                return Status::Skipped;
+            }
             if s == end {
                 self.state[iu] = NodeState::Fresh;
                 return end;

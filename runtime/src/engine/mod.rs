@@ -17,6 +17,8 @@ mod build;
 mod control;
 mod decorator;
 mod faults;
+mod flow;
+mod guard;
 mod leaf;
 mod record;
 mod state;
@@ -48,6 +50,9 @@ pub enum Status {
     Running,
     Success,
     Failure,
+    /// BT.CPP's SKIPPED: the node did not run (a precondition said so).
+    /// Returned to the parent; the node itself stays as it was.
+    Skipped,
 }
 
 impl Status {
@@ -57,6 +62,7 @@ impl Status {
             Status::Running => "RUNNING",
             Status::Success => "SUCCESS",
             Status::Failure => "FAILURE",
+            Status::Skipped => "SKIPPED",
         }
     }
 
@@ -73,7 +79,10 @@ pub(crate) enum Op {
     SequenceWithMemory,
     Fallback,
     ReactiveFallback,
-    Parallel { success: i32, failure: i32 },
+    Parallel {
+        success: i32,
+        failure: i32,
+    },
     Inverter,
     ForceSuccess,
     ForceFailure,
@@ -81,15 +90,37 @@ pub(crate) enum Op {
     Retry(i32),
     Repeat(i32),
     Timeout(u64),
+    IfThenElse,
+    WhileDoElse,
+    /// The variable is port `variable`; the cases are the `cases` ports
+    /// after `first_case`.
+    Switch {
+        variable: u32,
+        first_case: u32,
+        cases: u32,
+    },
+    Delay(u64),
+    RunOnce {
+        then_skip: bool,
+    },
+    Precondition {
+        script: u32,
+        otherwise: Status,
+    },
     SubTree,
     Step(u32),
     AlwaysSuccess,
     AlwaysFailure,
     Sleep(u32),
-    SetBlackboard { value: u32, slot: u32 },
+    SetBlackboard {
+        value: u32,
+        slot: u32,
+    },
     KbHolds(FormulaId),
     KbApply(EffectId),
     WaitForStep(u32),
+    Script(u32),
+    ScriptCondition(u32),
     Condition(u32),
     Action(u32),
 }
@@ -99,7 +130,13 @@ pub(crate) struct NodeDef {
     pub op: Op,
     pub first: u32,
     pub len: u32,
+    /// Its pre- and post-condition scripts (an index into
+    /// `Engine::guards`), or [`NO_GUARD`].
+    pub guard: u32,
 }
+
+/// A node without pre- or post-conditions.
+pub(crate) const NO_GUARD: u32 = u32::MAX;
 
 /// What the trace and the reports say about a node.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -171,6 +208,8 @@ pub struct Engine<'w> {
     pub(crate) ports: Vec<PortBind>,
     pub(crate) actions: Vec<ActionInfo>,
     pub(crate) conds: Vec<CondInfo>,
+    pub(crate) scripts: Vec<guard::CompiledScript>,
+    pub(crate) guards: Vec<guard::Guard>,
     /// Blackboard entry names (`Tree#instance/key`) and values.
     pub slot_names: Vec<String>,
     pub(crate) bb: Vec<Value>,
@@ -365,6 +404,9 @@ impl<'w> Engine<'w> {
         let keep = match (def.op, self.state[iu]) {
             // BT.CPP v4 keeps the index of a halted SequenceWithMemory.
             (Op::SequenceWithMemory, _) => self.status[iu] == Status::Running,
+            // RunOnce remembers for good that it ran, and Precondition that
+            // its child was let in (neither resets on halt in BT.CPP).
+            (Op::RunOnce { .. } | Op::Precondition { .. }, _) => true,
             // A halted action's command still runs; its completion is moot.
             (Op::Action(_), NodeState::Commanded(seq)) => {
                 if let Some(c) = self.controller.as_mut() {
@@ -377,14 +419,33 @@ impl<'w> Engine<'w> {
         if !keep {
             self.state[iu] = NodeState::Fresh;
         }
+        if def.guard != NO_GUARD && self.status[iu] == Status::Running {
+            self.on_halted(i, def.guard);
+        }
         self.set(iu, Status::Idle);
     }
 
-    /// Ticks node `i`: the family's semantics, then the status is set.
+    /// Ticks node `i`: its pre-conditions, the family's semantics, its
+    /// post-conditions, then the status is set (a SKIPPED node keeps its
+    /// own, as in BT.CPP).
+    #[inline]
     pub(crate) fn tick_node(&mut self, i: u32) -> Status {
         let iu = i as usize;
         let def = self.nodes[iu];
-        let s = match def.op {
+        if def.guard != NO_GUARD {
+            return self.tick_guarded(i, def);
+        }
+        let s = self.tick_op(i, def);
+        if s != Status::Skipped {
+            self.set(iu, s);
+        }
+        s
+    }
+
+    #[inline]
+    pub(crate) fn tick_op(&mut self, i: u32, def: NodeDef) -> Status {
+        let iu = i as usize;
+        match def.op {
             Op::Sequence => self.tick_ordered::<false, false, false>(iu, def),
             Op::SequenceWithMemory => self.tick_ordered::<false, false, true>(iu, def),
             Op::Fallback => self.tick_ordered::<true, false, false>(iu, def),
@@ -399,6 +460,18 @@ impl<'w> Engine<'w> {
             Op::Retry(n) => self.tick_loop::<true>(iu, def, n),
             Op::Repeat(n) => self.tick_loop::<false>(iu, def, n),
             Op::Timeout(msec) => self.tick_timeout(i, def, msec),
+            Op::IfThenElse => self.tick_if_then_else(i, def),
+            Op::WhileDoElse => self.tick_while_do_else(i, def),
+            Op::Switch {
+                variable,
+                first_case,
+                cases,
+            } => self.tick_switch(iu, def, variable, first_case, cases),
+            Op::Delay(msec) => self.tick_delay(iu, def, msec),
+            Op::RunOnce { then_skip } => self.tick_run_once(iu, def, then_skip),
+            Op::Precondition { script, otherwise } => {
+                self.tick_precondition(i, def, script, otherwise)
+            }
             Op::Step(k) => self.tick_step(i, def, k),
             Op::AlwaysSuccess => Status::Success,
             Op::AlwaysFailure => self.fail(i, "AlwaysFailure"),
@@ -407,11 +480,11 @@ impl<'w> Engine<'w> {
             Op::KbHolds(f) => self.tick_kb_holds(i, f),
             Op::KbApply(e) => self.tick_kb_apply(e),
             Op::WaitForStep(k) => self.tick_wait_for_step(i, k),
+            Op::Script(k) => self.tick_script(i, k),
+            Op::ScriptCondition(k) => self.tick_script_condition(i, k),
             Op::Condition(c) => self.tick_condition(i, c),
             Op::Action(a) => self.tick_action(i, a),
-        };
-        self.set(iu, s);
-        s
+        }
     }
 }
 

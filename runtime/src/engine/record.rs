@@ -102,8 +102,9 @@ impl<'w> Engine<'w> {
         }
     }
 
-    /// After the run: the record of the failure that ended it, or of the
-    /// goal that does not hold.
+    /// After the run: the record of the failure that ended it, of the goal
+    /// that does not hold, or of a tree still running (a SKIPPED root
+    /// leaves none).
     pub(super) fn finish(&mut self, s: Status) {
         if s == Status::Failure {
             if let Some((node, r)) = self.last_failure.clone() {
@@ -123,7 +124,7 @@ impl<'w> Engine<'w> {
                     )),
                 );
             }
-        } else {
+        } else if s == Status::Running {
             let t = self.tick;
             self.record(
                 0,

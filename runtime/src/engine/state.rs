@@ -7,8 +7,15 @@
 pub(crate) enum NodeState {
     #[default]
     Fresh,
-    /// Sequence and Fallback families: the child to tick next.
-    Child(u32),
+    /// Sequence and Fallback families: the child to tick next, and how
+    /// many were SKIPPED so far.
+    Child { next: u32, skipped: u32 },
+    /// IfThenElse: the branch taken; Switch: the child running.
+    Branch(u32),
+    /// Precondition: its script held, the child runs until it is done.
+    Admitted,
+    /// RunOnce: the child ran, and returned this.
+    Ran(super::Status),
     /// Parallel: how many children have succeeded and failed so far.
     Tally { success: u32, failure: u32 },
     /// Retry and Repeat: the attempts (or cycles) made so far.
@@ -22,12 +29,12 @@ pub(crate) enum NodeState {
 }
 
 impl NodeState {
-    /// The child a Sequence or Fallback ticks next.
+    /// The child a Sequence or Fallback ticks next, and the skipped ones.
     #[inline]
-    pub fn child(self) -> u32 {
+    pub fn child(self) -> (u32, u32) {
         match self {
-            NodeState::Child(j) => j,
-            _ => 0,
+            NodeState::Child { next, skipped } => (next, skipped),
+            _ => (0, 0),
         }
     }
 

@@ -10,6 +10,7 @@ fn leaf(id: &str) -> SNode {
         },
         name: None,
         children: Vec::new(),
+        scripts: Default::default(),
         at: None,
     }
 }
@@ -21,18 +22,21 @@ fn a_failure_made_by_a_decorator_is_recorded_as_its_own() {
         kind: Kind::Fallback,
         name: None,
         children: vec![leaf("AlwaysFailure"), leaf("AlwaysSuccess")],
+        scripts: Default::default(),
         at: None,
     };
     let inverter = SNode {
         kind: Kind::Inverter,
         name: Some("not done".into()),
         children: vec![leaf("AlwaysSuccess")],
+        scripts: Default::default(),
         at: None,
     };
     let root = SNode {
         kind: Kind::Sequence,
         name: None,
         children: vec![fallback, inverter],
+        scripts: Default::default(),
         at: None,
     };
     let doc = TreeDoc {
@@ -61,6 +65,7 @@ fn an_empty_tree_of_one_leaf_runs() {
                 },
                 name: None,
                 children: Vec::new(),
+                scripts: Default::default(),
                 at: None,
             },
         )],
