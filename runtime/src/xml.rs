@@ -7,7 +7,7 @@
 
 use crate::engine::MAX_DEPTH;
 use crate::error::LoadError;
-use crate::spec::{Kind, NodeScripts, SNode, TreeDoc, Verdict};
+use crate::spec::{Amount, Kind, NodeScripts, SNode, TreeDoc, Verdict};
 use btc_ir::{LeafKind, NodeModel, PortDirection, PortModel, PortValue};
 use btc_pddl::diagnostic::{codes, did_you_mean};
 use btc_pddl::logic::decode;
@@ -63,6 +63,13 @@ impl Elem {
             )
             .at(self.at)),
         }
+    }
+
+    /// `k="{key}"`: the blackboard entry the attribute reads.
+    fn entry(&self, k: &str) -> Option<String> {
+        let v = self.get(k)?.trim();
+        let key = v.strip_prefix('{')?.strip_suffix('}')?;
+        (!key.is_empty()).then(|| key.to_owned())
     }
 
     fn count(&self, k: &str, default: Option<i64>) -> Result<i32, LoadError> {
@@ -166,14 +173,24 @@ fn node_of(mut e: Elem) -> Result<SNode, LoadError> {
         "ForceSuccess" => Kind::ForceSuccess,
         "ForceFailure" => Kind::ForceFailure,
         "KeepRunningUntilFailure" => Kind::KeepRunningUntilFailure,
-        "RetryUntilSuccessful" => Kind::Retry(e.count("num_attempts", None)?),
-        "Repeat" => Kind::Repeat(e.count("num_cycles", None)?),
-        "Timeout" => {
-            let ms = e.int("msec", None)?;
-            Kind::Timeout(u64::try_from(ms).map_err(|_| {
-                LoadError::new(codes::X_BAD_PORT, "<Timeout>: `msec` must not be negative").at(e.at)
-            })?)
-        }
+        "RetryUntilSuccessful" => Kind::Retry(match e.entry("num_attempts") {
+            Some(k) => Amount::Entry(k),
+            None => Amount::Fixed(e.count("num_attempts", None)?),
+        }),
+        "Repeat" => Kind::Repeat(match e.entry("num_cycles") {
+            Some(k) => Amount::Entry(k),
+            None => Amount::Fixed(e.count("num_cycles", None)?),
+        }),
+        "Timeout" => Kind::Timeout(match e.entry("msec") {
+            Some(k) => Amount::Entry(k),
+            None => {
+                let ms = e.int("msec", None)?;
+                Amount::Fixed(u64::try_from(ms).map_err(|_| {
+                    LoadError::new(codes::X_BAD_PORT, "<Timeout>: `msec` must not be negative")
+                        .at(e.at)
+                })?)
+            }
+        }),
         "IfThenElse" => Kind::IfThenElse,
         "WhileDoElse" => Kind::WhileDoElse,
         "Switch2" | "Switch3" | "Switch4" | "Switch5" | "Switch6" => {

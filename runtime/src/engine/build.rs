@@ -7,12 +7,12 @@ use super::control::threshold;
 use super::guard::{CompiledScript, Guard};
 use super::state::NodeState;
 use super::step::StepRt;
-use super::NO_GUARD;
 use super::{ActionInfo, CondInfo, Engine, NodeDef, NodeMeta, Op, Options, PortBind, Src, Status};
+use super::{Arg, NO_GUARD};
 use super::{Value, MAX_CALLS, MAX_DEPTH};
 use crate::error::LoadError;
 use crate::kb::{ConditionId, EffectId, FormulaId, Kb};
-use crate::spec::{default_name, Kind, NodeScripts, SNode, TreeDoc, Verdict};
+use crate::spec::{default_name, Amount, Kind, NodeScripts, SNode, TreeDoc, Verdict};
 use btc_ir::{LeafKind, NodeModel, PortValue};
 use btc_pddl::diagnostic::{codes, did_you_mean};
 use btc_pddl::logic::{self, Binding, Effect, Formula, Name, Terms};
@@ -295,9 +295,9 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
             Kind::ForceSuccess => Op::ForceSuccess,
             Kind::ForceFailure => Op::ForceFailure,
             Kind::KeepRunningUntilFailure => Op::KeepRunningUntilFailure,
-            Kind::Retry(k) => Op::Retry(*k),
-            Kind::Repeat(k) => Op::Repeat(*k),
-            Kind::Timeout(ms) => Op::Timeout(*ms),
+            Kind::Retry(k) => Op::Retry(self.arg(k, scope)),
+            Kind::Repeat(k) => Op::Repeat(self.arg(k, scope)),
+            Kind::Timeout(ms) => Op::Timeout(self.arg(ms, scope)),
             Kind::IfThenElse => {
                 arity(&[2, 3], self)?;
                 Op::IfThenElse
@@ -587,6 +587,14 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
         }
         self.e.guards.push(g);
         Ok((self.e.guards.len() - 1) as u32)
+    }
+
+    /// A decorator's count: fixed, or the slot of the blackboard entry it reads.
+    fn arg<T: Copy>(&mut self, a: &Amount<T>, scope: &mut Scope) -> Arg<T> {
+        match a {
+            Amount::Fixed(n) => Arg::Fixed(*n),
+            Amount::Entry(key) => Arg::Slot(self.slot_in(scope, key)),
+        }
     }
 
     fn slot_in(&mut self, scope: &mut Scope, key: &str) -> u32 {

@@ -4,7 +4,7 @@
 
 use super::record::Reason;
 use super::state::NodeState;
-use super::{Engine, NodeDef, Op, Status};
+use super::{Arg, Engine, NodeDef, Op, Status};
 
 impl<'w> Engine<'w> {
     /// The decorators that map their child's status.
@@ -31,10 +31,19 @@ impl<'w> Engine<'w> {
     /// counts successes and stops at a failure. `n < 0`: forever.
     pub(super) fn tick_loop<const RETRY: bool>(
         &mut self,
-        iu: usize,
+        i: u32,
         def: NodeDef,
-        n: i32,
+        n: Arg<i32>,
     ) -> Status {
+        let iu = i as usize;
+        let what = if RETRY { "num_attempts" } else { "num_cycles" };
+        let n = match self.amount(n, what, |n| i32::try_from(n).ok().filter(|n| *n >= -1)) {
+            Ok(n) => n,
+            Err(r) => {
+                self.note_failure(i, r);
+                return Status::Failure;
+            }
+        };
         self.set(iu, Status::Running);
         let c = self.kid(def, 0);
         let (again, end) = if RETRY {
@@ -69,17 +78,29 @@ impl<'w> Engine<'w> {
         }
     }
 
-    pub(super) fn tick_timeout(&mut self, i: u32, def: NodeDef, msec: u64) -> Status {
+    pub(super) fn tick_timeout(&mut self, i: u32, def: NodeDef, arg: Arg<u64>) -> Status {
         let iu = i as usize;
         let c = self.kid(def, 0);
         if self.status[iu] != Status::Running {
+            // Read when the timeout starts, as BT.CPP does.
+            let msec = match self.amount(arg, "msec", |n| u64::try_from(n).ok()) {
+                Ok(ms) => ms,
+                Err(r) => {
+                    self.note_failure(i, r);
+                    return Status::Failure;
+                }
+            };
             self.set(iu, Status::Running);
-            self.state[iu] = NodeState::Until(self.now_ms.saturating_add(msec));
+            self.state[iu] = NodeState::Deadline {
+                until: self.now_ms.saturating_add(msec),
+                msec: u32::try_from(msec).unwrap_or(u32::MAX),
+            };
         }
-        if msec > 0
-            && self.now_ms >= self.state[iu].until()
-            && self.status[c as usize] == Status::Running
-        {
+        let (until, msec) = match self.state[iu] {
+            NodeState::Deadline { until, msec } => (until, msec),
+            _ => (0, 0),
+        };
+        if msec > 0 && self.now_ms >= until && self.status[c as usize] == Status::Running {
             self.reset(c);
             self.note_failure(i, Reason::Plain(format!("timed out after {msec} ms")));
             Status::Failure
@@ -89,6 +110,28 @@ impl<'w> Engine<'w> {
                 self.reset(c);
             }
             s
+        }
+    }
+
+    /// A decorator's count: fixed, or read from its blackboard slot (a fault
+    /// reason when the entry holds no number the decorator takes).
+    fn amount<T: Copy>(
+        &self,
+        a: Arg<T>,
+        port: &str,
+        fit: impl Fn(i64) -> Option<T>,
+    ) -> Result<T, Reason> {
+        match a {
+            Arg::Fixed(n) => Ok(n),
+            Arg::Slot(s) => {
+                let v = &self.bb[s as usize];
+                v.as_int().and_then(fit).ok_or_else(|| {
+                    Reason::Plain(format!(
+                        "`{port}` reads `{}` from the blackboard, which is not a number it takes",
+                        v.text()
+                    ))
+                })
+            }
         }
     }
 }

@@ -87,9 +87,9 @@ pub(crate) enum Op {
     ForceSuccess,
     ForceFailure,
     KeepRunningUntilFailure,
-    Retry(i32),
-    Repeat(i32),
-    Timeout(u64),
+    Retry(Arg<i32>),
+    Repeat(Arg<i32>),
+    Timeout(Arg<u64>),
     IfThenElse,
     WhileDoElse,
     /// The variable is port `variable`; the cases are the `cases` ports
@@ -123,6 +123,14 @@ pub(crate) enum Op {
     ScriptCondition(u32),
     Condition(u32),
     Action(u32),
+}
+
+/// A decorator's count or duration: fixed, or read from a blackboard slot
+/// when the node is ticked.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Arg<T> {
+    Fixed(T),
+    Slot(u32),
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -457,8 +465,8 @@ impl<'w> Engine<'w> {
             | Op::ForceFailure
             | Op::KeepRunningUntilFailure
             | Op::SubTree => self.tick_wrapper(i, def),
-            Op::Retry(n) => self.tick_loop::<true>(iu, def, n),
-            Op::Repeat(n) => self.tick_loop::<false>(iu, def, n),
+            Op::Retry(n) => self.tick_loop::<true>(i, def, n),
+            Op::Repeat(n) => self.tick_loop::<false>(i, def, n),
             Op::Timeout(msec) => self.tick_timeout(i, def, msec),
             Op::IfThenElse => self.tick_if_then_else(i, def),
             Op::WhileDoElse => self.tick_while_do_else(i, def),

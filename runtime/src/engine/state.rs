@@ -22,6 +22,8 @@ pub(crate) enum NodeState {
     Attempts(u32),
     /// Timeout and Sleep: the simulated time (ms) at which it ends.
     Until(u64),
+    /// Timeout: when it ends, and its duration as read when it started.
+    Deadline { until: u64, msec: u32 },
     /// A simulated action leaf: the ticks it stays RUNNING.
     Working(u64),
     /// An action leaf whose command the controller runs: its number.
