@@ -92,12 +92,21 @@ pub fn check(path: &Path, format: Format) -> anyhow::Result<ExitCode> {
     })
 }
 
+/// What `btc compile` writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Output {
+    /// The compiled tree in a format.
+    Tree(emit::Format),
+    /// The problem's world as a `.kb` file (for the C++ knowledge base).
+    Kb,
+}
+
 pub struct CompileArgs {
     pub rules: PathBuf,
     pub plan: PathBuf,
     pub problem: Option<PathBuf>,
     pub domain: Option<PathBuf>,
-    pub emit: emit::Format,
+    pub emit: Output,
     pub output: Option<PathBuf>,
     pub options: emit::Options,
     pub format: Format,
@@ -211,15 +220,21 @@ pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
     };
     let text = match (&a.output, a.emit) {
         // A JSON IR records its PDDL files relative to itself.
-        (Some(out), emit::Format::Json) => {
+        (Some(out), Output::Tree(f @ emit::Format::Json)) => {
             let mut ir = ir.clone();
             let dir = out.parent().unwrap_or(Path::new(""));
             for p in [&mut ir.domain, &mut ir.problem] {
                 *p = crate::paths::text(&crate::paths::relative_to(Path::new(p.as_str()), dir));
             }
-            emit::emit(&ir, a.emit, &a.options)
+            emit::emit(&ir, f, &a.options)
         }
-        _ => emit::emit(ir, a.emit, &a.options),
+        (_, Output::Tree(f)) => emit::emit(ir, f, &a.options),
+        (_, Output::Kb) => match db::JobWorld::of(&database, job) {
+            Some(w) => emit::kb::emit(w.domain, w.dix, w.problem, w.pix),
+            None => anyhow::bail!(
+                "`--emit kb` needs the PDDL problem: pass `--problem PROBLEM` or name it in the rules file"
+            ),
+        },
     };
     match &a.output {
         Some(out) => {

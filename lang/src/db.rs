@@ -162,9 +162,26 @@ pub fn file_id(_db: &dyn Db, f: SourceFile) -> FileId {
 /// edit re-parses only the items whose text it changed.
 #[salsa::tracked(returns(ref))]
 pub fn parsed_rules(db: &dyn Db, file: SourceFile) -> ParsedRules {
+    if is_palette(file.path(db)) {
+        let (items, diagnostics) =
+            crate::rules::palette::parse_palette(file.text(db), file_id(db, file));
+        return ParsedRules {
+            items,
+            comments: Vec::new(),
+            diagnostics,
+        };
+    }
     parse_rules_with(file.text(db), file_id(db, file), |text| {
         parsed_item(db, ItemText::new(db, file, text.to_owned())).clone()
     })
+}
+
+/// Whether an imported file is a BT.CPP node palette (`.xml`) rather than
+/// rules.
+pub fn is_palette(path: &str) -> bool {
+    std::path::Path::new(path)
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("xml"))
 }
 
 /// The text of one top-level item of a rules file.
@@ -517,6 +534,12 @@ pub fn rules_diagnostics(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
     let parsed = parsed_rules(db, file);
     let mut out = parsed.diagnostics.clone();
     out.extend(import_closure(db, file).1.iter().cloned());
+    // A palette's problems are reported with the file that imports it.
+    for &f in import_closure(db, file).0.iter().skip(1) {
+        if is_palette(f.path(db)) {
+            out.extend(parsed_rules(db, f).diagnostics.iter().cloned());
+        }
+    }
     for item in rules_items(db, file) {
         let offset = item.offset(db);
         out.extend(
@@ -633,6 +656,16 @@ mod tests {
             .iter()
             .map(|d| btc_pddl::render::to_short(d, &sources))
             .collect()
+    }
+
+    #[test]
+    fn normalized_paths_keep_one_root_slash() {
+        let n = |p: &str| normalize(std::path::Path::new(p));
+        assert_eq!(n("/tmp/x/./rules.btrules"), "/tmp/x/rules.btrules");
+        assert_eq!(n("/tmp/x/../domain.pddl"), "/tmp/domain.pddl");
+        assert_eq!(n("/../domain.pddl"), "/../domain.pddl");
+        assert_eq!(n("a/./b/../c"), "a/c");
+        assert_eq!(n("../a/b"), "../a/b");
     }
 
     #[test]

@@ -7,5 +7,6 @@
 //! read files and hand their texts to [`db`].
 
 pub mod db;
+pub mod declared;
 pub mod lower;
 pub mod rules;

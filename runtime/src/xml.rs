@@ -7,7 +7,7 @@
 
 use crate::engine::MAX_DEPTH;
 use crate::error::LoadError;
-use crate::spec::{Amount, Kind, NodeScripts, SNode, TreeDoc, Verdict};
+use crate::spec::{Amount, Kind, NodeScripts, SNode, StepConditions, TreeDoc, Verdict};
 use btc_ir::{LeafKind, NodeModel, PortDirection, PortModel, PortValue};
 use btc_pddl::diagnostic::{codes, did_you_mean};
 use btc_pddl::logic::decode;
@@ -156,6 +156,17 @@ fn verdict(e: &Elem, key: &str, default: Verdict) -> Result<Verdict, LoadError> 
     })
 }
 
+/// A `KbStep`'s condition attributes, when it has any.
+fn step_conditions(e: &Elem) -> Result<Option<Box<StepConditions>>, LoadError> {
+    let get = |k: &str| pddl(e, k, decode::formula, "a condition");
+    let c = StepConditions {
+        start: get("start_condition")?,
+        over_all: get("over_all_condition")?,
+        end: get("end_condition")?,
+    };
+    Ok((c != StepConditions::default()).then(|| Box::new(c)))
+}
+
 fn node_of(mut e: Elem) -> Result<SNode, LoadError> {
     let name = e.get("name").map(str::to_owned);
     let scripts = node_scripts(&mut e)?;
@@ -273,6 +284,7 @@ fn node_of(mut e: Elem) -> Result<SNode, LoadError> {
                 step: step - 1,
                 start_effect: pddl(&e, "start_effect", decode::effect, "an effect")?,
                 end_effect: pddl(&e, "end_effect", decode::effect, "an effect")?,
+                conditions: step_conditions(&e)?,
             }
         }
         // Groot 1 spelling: <Action ID="MoveTo" .../>.

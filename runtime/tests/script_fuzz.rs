@@ -6,9 +6,6 @@
 //! (`integrations/btcpp/build-btcpp.sh`); skipped without one, required
 //! under CI=true.
 
-#[path = "../peer/locate.rs"]
-mod locate;
-
 use btc_runtime::script::{self, Env};
 use btc_runtime::Value;
 use std::io::Write;
@@ -143,12 +140,8 @@ fn agree(a: &str, b: &str) -> bool {
 
 #[test]
 fn random_scripts_evaluate_as_in_bt_cpp() {
-    let peer = match locate::peer() {
-        Ok(p) => p,
-        Err(why) => {
-            btc_testkit::skip("BehaviorTree.CPP 4.10", &why);
-            return;
-        }
+    let Some(peer) = btc_testkit::btcpp_harness().map(|d| d.join("btc_peer")) else {
+        return;
     };
     let mut scripts = Vec::new();
     for seed in 1..=4u64 {

@@ -102,8 +102,9 @@ fn delay_waits_run_once_runs_once_and_precondition_gates() {
     let (e, s) = run("delay_run_once");
     assert_eq!(s, Status::Success);
     // 30 ms at 10 ms per tick: the delay starts on tick 1, its child runs
-    // on tick 4.
-    assert_eq!(e.tick, 4);
+    // on tick 4. Then each of Repeat's cycles, started and finished in one
+    // tick, hands the flow back (BT.CPP 4.10): cycles on ticks 4, 5 and 6.
+    assert_eq!(e.tick, 6);
     assert_eq!(bb(&e, "delayed"), Some(&Value::Int(1)));
     assert_eq!(bb(&e, "once"), Some(&Value::Int(1)));
     assert_eq!(bb(&e, "every"), Some(&Value::Int(3)));

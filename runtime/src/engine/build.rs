@@ -12,7 +12,9 @@ use super::{Arg, NO_GUARD};
 use super::{Value, MAX_CALLS, MAX_DEPTH};
 use crate::error::LoadError;
 use crate::kb::{ConditionId, EffectId, FormulaId, Kb};
-use crate::spec::{default_name, Amount, Kind, NodeScripts, SNode, TreeDoc, Verdict};
+use crate::spec::{
+    default_name, Amount, Kind, NodeScripts, SNode, StepConditions, TreeDoc, Verdict,
+};
 use btc_ir::{LeafKind, NodeModel, PortValue};
 use btc_pddl::diagnostic::{codes, did_you_mean};
 use btc_pddl::logic::{self, Binding, Effect, Formula, Name, Terms};
@@ -68,7 +70,9 @@ impl<'w> Engine<'w> {
             faults: Vec::new(),
             faults_live: false,
             controller: None,
+            handlers: Vec::new(),
             record_slots: [0; 4],
+            step_running: None,
         };
         e.load_steps(doc)?;
         let main = doc.tree(&doc.main).ok_or_else(|| {
@@ -340,6 +344,7 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
                 step: k,
                 start_effect,
                 end_effect,
+                conditions,
             } => {
                 let k32 = u32::try_from(*k).unwrap_or(u32::MAX);
                 while self.e.steps.len() <= *k && self.e.steps.len() < 100_000 {
@@ -362,7 +367,11 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
                 if *k >= self.doc.steps.len() && self.e.steps[*k].skipped {
                     self.e.steps[*k].skipped = false;
                     if let Some(nm) = &n.name {
-                        self.derive_step(*k, nm).map_err(|e| e.at_opt(n.at))?;
+                        self.derive_step(*k, nm, conditions.is_none())
+                            .map_err(|e| e.at_opt(n.at))?;
+                    }
+                    if let Some(c) = conditions {
+                        self.given_conditions(*k, c).map_err(|e| e.at_opt(n.at))?;
                     }
                 }
                 let label = format!("`{}`", self.e.steps[*k].label);
@@ -475,6 +484,16 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
             let outer = std::mem::replace(&mut self.tree, inst);
             let c = self.node(def, &mut child, my_step, Some(me), depth + 1, calls + 1);
             self.tree = outer;
+            if *autoremap {
+                // BT.CPP creates an autoremapped subtree's new entries in
+                // the parent's blackboard (all but `_private` ones and the
+                // call's own ports): later nodes of the parent see them.
+                for (k, slot) in child {
+                    if !k.starts_with('_') && !ports.iter().any(|(p, _)| *p == k) {
+                        scope.entry(k).or_insert(slot);
+                    }
+                }
+            }
             self.pending.push(c?);
         } else {
             for c in &n.children {
@@ -494,9 +513,23 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
         Ok(me)
     }
 
+    /// A step's conditions as its `KbStep` gives them.
+    fn given_conditions(&mut self, k: usize, c: &StepConditions) -> Result<(), LoadError> {
+        let what = format!("`{}`", self.e.steps[k].label);
+        let start = self.e.kb_formula(c.start.as_ref(), &what)?;
+        let over_all = self.e.kb_formula(c.over_all.as_ref(), &what)?;
+        let end = self.e.kb_formula(c.end.as_ref(), &what)?;
+        let st = &mut self.e.steps[k];
+        st.pre_start = start;
+        st.pre_over_all = over_all;
+        st.pre_end = end;
+        Ok(())
+    }
+
     /// A step known only from a tree file (`KbStep name="step 3: (grasp r
-    /// p bin1)"`): its conditions are the domain action's, grounded.
-    fn derive_step(&mut self, k: usize, name: &str) -> Result<(), LoadError> {
+    /// p bin1)"`): its label, and unless the file gives them (`conditions`
+    /// false), its conditions: the domain action's, grounded.
+    fn derive_step(&mut self, k: usize, name: &str, conditions: bool) -> Result<(), LoadError> {
         let Some(open) = name.find('(') else {
             return Ok(());
         };
@@ -533,6 +566,10 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
                 .collect::<Vec<_>>()
                 .join(" ")
         );
+        if !conditions {
+            self.e.steps[k].label = label;
+            return Ok(());
+        }
         let what = format!("`{label}`");
         let pre_start = self.e.kb_formula(pre_start.as_ref(), &what)?;
         let over_all = self.e.kb_formula(over_all.as_ref(), &what)?;
@@ -883,6 +920,7 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
                 self.e.actions.push(ActionInfo {
                     id: id.into(),
                     ports: range,
+                    handler: None,
                 });
                 Op::Action(a)
             }

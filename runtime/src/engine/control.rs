@@ -22,12 +22,18 @@ impl<'w> Engine<'w> {
         } else {
             (Status::Failure, Status::Success)
         };
+        let active = self.status[iu] == Status::Running;
         self.set(iu, Status::Running);
         let (mut idx, mut skipped) = if REACTIVE {
             (0, 0)
         } else {
             self.state[iu].child()
         };
+        if !active {
+            // BT.CPP counts the skipped children of this run only (a halted
+            // SequenceWithMemory keeps its index, not its count).
+            skipped = 0;
+        }
         loop {
             if idx >= def.len {
                 self.reset_children(def, 0);
@@ -39,6 +45,7 @@ impl<'w> Engine<'w> {
                 };
             }
             let c = self.kid(def, idx);
+            let fresh = MEMORY && self.status[c as usize] == Status::Idle;
             let s = self.tick_node(c);
             if s == Status::Running {
                 if REACTIVE {
@@ -70,6 +77,13 @@ impl<'w> Engine<'w> {
                 }
             }
             idx += 1;
+            // BT.CPP 4.10: a SequenceWithMemory child that started and
+            // succeeded in this tick hands the flow back (RUNNING); the next
+            // one runs at the next tick.
+            if fresh && s == done && idx < def.len {
+                self.state[iu] = NodeState::Child { next: idx, skipped };
+                return Status::Running;
+            }
         }
     }
 

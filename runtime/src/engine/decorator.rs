@@ -51,28 +51,38 @@ impl<'w> Engine<'w> {
         } else {
             (Status::Success, Status::Failure)
         };
+        let more = |made: u32| n < 0 || (made as i64) < n as i64;
         loop {
             let made = self.state[iu].attempts();
-            if !(n < 0 || (made as i64) < n as i64) {
+            if !more(made) {
                 self.state[iu] = NodeState::Fresh;
                 return again;
             }
+            let fresh = self.status[c as usize] == Status::Idle;
             let s = self.tick_node(c);
             if s == Status::Running {
                 return Status::Running;
             }
             self.reset(c);
             if s == Status::Skipped {
-                self.state[iu] = NodeState::Fresh;
+                // The attempts made so far stay counted, as in BT.CPP.
                 return Status::Skipped;
             }
             if s == end {
                 self.state[iu] = NodeState::Fresh;
                 return end;
             }
-            self.state[iu] = NodeState::Attempts(made.saturating_add(1));
-            if n < 0 {
-                // Forever: one attempt per tick, so a tick ends.
+            let made = made.saturating_add(1);
+            if !more(made) {
+                self.state[iu] = NodeState::Fresh;
+                return again;
+            }
+            self.state[iu] = NodeState::Attempts(made);
+            // BT.CPP 4.10: an attempt that started and ended in this tick
+            // hands the flow back (RUNNING); the next attempt runs at the
+            // next tick. After a child that was RUNNING, the next attempt
+            // starts at once.
+            if fresh {
                 return Status::Running;
             }
         }

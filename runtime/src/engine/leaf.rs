@@ -119,6 +119,9 @@ impl<'w> Engine<'w> {
     }
 
     pub(super) fn tick_action(&mut self, i: u32, a: u32) -> Status {
+        if let Some(h) = self.actions[a as usize].handler {
+            return self.tick_handled(i, a, h);
+        }
         let iu = i as usize;
         let running = self.status[iu] == Status::Running;
         if self.faults_live {

@@ -174,6 +174,8 @@ pub(crate) struct PortBind {
 pub(crate) struct ActionInfo {
     pub id: Box<str>,
     pub ports: (u32, u32),
+    /// The embedder's implementation ([`Engine::set_action_handler`]).
+    pub handler: Option<u32>,
 }
 
 pub(crate) struct CondInfo {
@@ -236,7 +238,10 @@ pub struct Engine<'w> {
     /// Some fault is pending or in effect: leaves consult the faults.
     pub(crate) faults_live: bool,
     pub(crate) controller: Option<Controller>,
+    pub(crate) handlers: Vec<crate::handler::ActionHandler<'w>>,
     pub(crate) record_slots: [u32; 4],
+    /// The step that started last, while it has not finished.
+    pub(crate) step_running: Option<u32>,
 }
 
 impl<'w> Engine<'w> {
@@ -400,18 +405,29 @@ impl<'w> Engine<'w> {
         }
     }
 
-    /// BT.CPP's halt + resetStatus: running descendants are halted, then
-    /// the node goes back to IDLE.
+    /// BT.CPP's `haltChild`: a RUNNING node is halted (its own state
+    /// cleared, its children reset), then the node goes back to IDLE. A
+    /// node that finished only goes back to IDLE: what is below it, and its
+    /// own state, stay as they are (BT.CPP's `resetStatus`).
     pub(crate) fn reset(&mut self, i: u32) {
         let iu = i as usize;
-        if self.status[iu] == Status::Idle {
-            return;
+        match self.status[iu] {
+            Status::Idle => return,
+            Status::Running => self.halt(i),
+            _ => {}
         }
+        self.set(iu, Status::Idle);
+    }
+
+    /// BT.CPP's `halt()` of a RUNNING node: its children are reset, its
+    /// state is cleared (but what BT.CPP keeps), its `_onHalted` runs.
+    fn halt(&mut self, i: u32) {
+        let iu = i as usize;
         let def = self.nodes[iu];
         self.reset_children(def, 0);
         let keep = match (def.op, self.state[iu]) {
             // BT.CPP v4 keeps the index of a halted SequenceWithMemory.
-            (Op::SequenceWithMemory, _) => self.status[iu] == Status::Running,
+            (Op::SequenceWithMemory, _) => true,
             // RunOnce remembers for good that it ran, and Precondition that
             // its child was let in (neither resets on halt in BT.CPP).
             (Op::RunOnce { .. } | Op::Precondition { .. }, _) => true,
@@ -427,10 +443,9 @@ impl<'w> Engine<'w> {
         if !keep {
             self.state[iu] = NodeState::Fresh;
         }
-        if def.guard != NO_GUARD && self.status[iu] == Status::Running {
+        if def.guard != NO_GUARD {
             self.on_halted(i, def.guard);
         }
-        self.set(iu, Status::Idle);
     }
 
     /// Ticks node `i`: its pre-conditions, the family's semantics, its

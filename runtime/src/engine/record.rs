@@ -25,7 +25,8 @@ pub struct FaultRecord {
     pub node: u32,
     pub node_id: String,
     pub node_name: String,
-    /// 1-based plan step.
+    /// 1-based plan step: the failing node's, or for a node outside every
+    /// step (a plan-level monitor), the step that was running.
     pub step: Option<usize>,
     pub action: Option<String>,
     pub reason: String,
@@ -75,7 +76,7 @@ impl<'w> Engine<'w> {
     pub(crate) fn record(&mut self, node: u32, r: &Reason) {
         let reason = self.reason_text(r);
         let meta = &self.meta[node as usize];
-        let step = meta.step.map(|s| s as usize);
+        let step = meta.step.or(self.step_running).map(|s| s as usize);
         let faults = self.faults_related(r, &reason);
         let rec = FaultRecord {
             tick: self.tick,

@@ -41,6 +41,7 @@ impl<'w> Engine<'w> {
             if !self.faults.is_empty() {
                 self.faults_on_step(ku);
             }
+            self.step_running = Some(k);
             if self.opts.trace {
                 self.trace.push(TraceItem::StepStarted {
                     tick: self.tick,
@@ -86,6 +87,9 @@ impl<'w> Engine<'w> {
             if !st.finished {
                 let eff = st.eff_end;
                 self.steps[ku].finished = true;
+                if self.step_running == Some(k) {
+                    self.step_running = None;
+                }
                 if let (Some(e), Some(kb)) = (eff, self.kb.as_mut()) {
                     kb.apply(e);
                 }

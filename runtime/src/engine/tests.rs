@@ -2,17 +2,7 @@ use super::*;
 use crate::spec::{Kind, SNode, TreeDoc};
 
 fn leaf(id: &str) -> SNode {
-    SNode {
-        kind: Kind::Leaf {
-            id: id.into(),
-            kind: None,
-            ports: Vec::new(),
-        },
-        name: None,
-        children: Vec::new(),
-        scripts: Default::default(),
-        at: None,
-    }
+    SNode::leaf(id)
 }
 
 #[test]

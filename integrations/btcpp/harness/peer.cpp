@@ -1,8 +1,7 @@
 // The BT.CPP 4.10 peer of btc's engine tests and benchmarks: the same
 // work done by real BehaviorTree.CPP, so that the two can be compared in
-// one run. Built by runtime/peer/build.rs's logic (see `peer` in
-// runtime/tests/script_fuzz.rs and runtime/benches/engine.rs) against the
-// cached BT.CPP build; not part of btc.
+// one run (runtime/tests/script_fuzz.rs, runtime/benches/engine.rs). Built
+// with the other harnesses by btc_testkit::btcpp_harness; not part of btc.
 //
 //   peer eval           one script per stdin line; prints its value or its
 //                       error class, one line each
