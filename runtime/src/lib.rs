@@ -15,6 +15,7 @@ pub mod engine;
 pub mod error;
 pub mod faults;
 pub mod handler;
+pub mod include;
 pub mod kb;
 pub mod script;
 pub mod spec;

@@ -167,7 +167,36 @@ fn step_conditions(e: &Elem) -> Result<Option<Box<StepConditions>>, LoadError> {
     Ok((c != StepConditions::default()).then(|| Box::new(c)))
 }
 
+/// BehaviorTree.CPP 4.10's built-in nodes that btc's engine does not run
+/// (`runtime/src/btcpp_builtins.xml` lists them all): refused by name
+/// rather than taken for a node of the embedder's.
+const NOT_RUN: [&str; 12] = [
+    "AsyncFallback",
+    "AsyncSequence",
+    "LoopBool",
+    "LoopDouble",
+    "LoopInt",
+    "LoopString",
+    "ParallelAll",
+    "SkipUnlessUpdated",
+    "TryCatch",
+    "UnsetBlackboard",
+    "WaitValueUpdate",
+    "WasEntryUpdated",
+];
+
 fn node_of(mut e: Elem) -> Result<SNode, LoadError> {
+    if NOT_RUN.contains(&e.name.as_str()) {
+        return Err(LoadError::new(
+            codes::X_UNSUPPORTED,
+            format!(
+                "<{}> is a BehaviorTree.CPP 4.10 node btc does not run",
+                e.name
+            ),
+        )
+        .at(e.at)
+        .hint("docs/runtime.md lists the nodes btc runs"));
+    }
     let name = e.get("name").map(str::to_owned);
     let scripts = node_scripts(&mut e)?;
     let kind = match e.name.as_str() {
@@ -422,8 +451,66 @@ enum Place {
     Skip(usize),
 }
 
-/// Parses a BT.CPP v4 XML document.
+/// An `<include path="...">` of a file, as written.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Include {
+    pub path: String,
+    /// Byte offset of the `<include>` element.
+    pub at: usize,
+}
+
+/// One file as read, before its includes are resolved and its main tree
+/// is chosen.
+#[derive(Debug)]
+pub struct Parsed {
+    /// Its trees and models (`main` still empty).
+    pub doc: TreeDoc,
+    /// Its `main_tree_to_execute`.
+    pub main: Option<String>,
+    pub includes: Vec<Include>,
+}
+
+/// Parses a BT.CPP v4 XML document that includes no other file (a tree
+/// read from text has no folder to find them in; [`crate::include::load`]
+/// reads a file and what it includes).
 pub fn parse(text: &str) -> Result<TreeDoc, LoadError> {
+    let p = parse_file(text)?;
+    if let Some(inc) = p.includes.first() {
+        return Err(LoadError::new(
+            codes::X_INCLUDE_READ,
+            format!(
+                "<include path=\"{}\">: this tree is read as text, with no folder to find the file in",
+                inc.path
+            ),
+        )
+        .at(inc.at)
+        .hint("run the tree from its file (`btc run --tree FILE`)"));
+    }
+    finish(p.doc, p.main)
+}
+
+/// The document's main tree: `main_tree_to_execute`, or its only tree.
+pub fn finish(mut doc: TreeDoc, main: Option<String>) -> Result<TreeDoc, LoadError> {
+    doc.main = match main {
+        Some(m) => m,
+        None if doc.trees.len() == 1 => doc.trees[0].0.clone(),
+        None => {
+            return Err(syntax("<root> does not say which tree to run", 0)
+                .hint("add `main_tree_to_execute=\"ID\"` to <root>"))
+        }
+    };
+    if doc.tree(&doc.main).is_none() {
+        return Err(LoadError::new(
+            codes::X_SUBTREE,
+            format!("the main tree `{}` is not defined in this file", doc.main),
+        ));
+    }
+    Ok(doc)
+}
+
+/// Parses one BT.CPP v4 XML file: its trees, models and includes.
+pub fn parse_file(text: &str) -> Result<Parsed, LoadError> {
+    let mut includes = Vec::new();
     let mut r = Reader::from_str(text);
     r.config_mut().trim_text(true);
     let mut doc = TreeDoc::default();
@@ -491,10 +578,29 @@ pub fn parse(text: &str) -> Result<TreeDoc, LoadError> {
                         }
                     }
                     "include" => {
-                        return Err(syntax(
-                            "<include> is not supported: put every tree in one file",
+                        if e.get("ros_pkg").is_some() {
+                            return Err(LoadError::new(
+                                codes::X_UNSUPPORTED,
+                                "<include ros_pkg>: btc does not look up ROS packages",
+                            )
+                            .at(at)
+                            .hint("give `path` relative to this file, without `ros_pkg`"));
+                        }
+                        let path = e.get("path").map(str::trim).filter(|p| !p.is_empty());
+                        let Some(path) = path else {
+                            return Err(LoadError::new(
+                                codes::X_INCLUDE_READ,
+                                "<include> needs the attribute `path`",
+                            )
+                            .at(at));
+                        };
+                        includes.push(Include {
+                            path: path.to_owned(),
                             at,
-                        ))
+                        });
+                        if !empty {
+                            place = Place::Skip(1);
+                        }
                     }
                     _ => {
                         if !empty {
@@ -596,21 +702,11 @@ pub fn parse(text: &str) -> Result<TreeDoc, LoadError> {
     if !saw_root {
         return Err(syntax("this file has no <root> element", 0));
     }
-    doc.main = match main {
-        Some(m) => m,
-        None if doc.trees.len() == 1 => doc.trees[0].0.clone(),
-        None => {
-            return Err(syntax("<root> does not say which tree to run", 0)
-                .hint("add `main_tree_to_execute=\"ID\"` to <root>"))
-        }
-    };
-    if doc.tree(&doc.main).is_none() {
-        return Err(LoadError::new(
-            codes::X_SUBTREE,
-            format!("the main tree `{}` is not defined in this file", doc.main),
-        ));
-    }
-    Ok(doc)
+    Ok(Parsed {
+        doc,
+        main,
+        includes,
+    })
 }
 
 #[cfg(test)]
@@ -641,7 +737,24 @@ mod tests {
         let e = parse("<root BTCPP_format=\"3\"></root>").unwrap_err();
         assert_eq!(e.code.id, "X001");
         let e = parse("<root><include path=\"x.xml\"/></root>").unwrap_err();
-        assert!(e.message.contains("include"));
+        assert_eq!(e.code.id, "X042");
+        let e = parse("<root><include ros_pkg=\"p\" path=\"x.xml\"/></root>").unwrap_err();
+        assert_eq!(e.code.id, "X041");
+    }
+
+    #[test]
+    fn bt_cpp_nodes_btc_does_not_run_are_refused_by_name() {
+        for id in NOT_RUN {
+            let text = format!(
+                "<root BTCPP_format=\"4\"><BehaviorTree ID=\"M\"><{id}/></BehaviorTree></root>"
+            );
+            let e = parse(&text).unwrap_err();
+            assert_eq!(e.code.id, "X041", "{id}");
+            assert_eq!(
+                e.message,
+                format!("<{id}> is a BehaviorTree.CPP 4.10 node btc does not run")
+            );
+        }
     }
 
     #[test]

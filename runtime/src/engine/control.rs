@@ -112,7 +112,9 @@ impl<'w> Engine<'w> {
                     _ => {}
                 }
             }
-            if succ >= need_s {
+            // With a threshold counted from the end, SKIPPED children count
+            // as successes (BT.CPP 4.10).
+            if succ >= need_s || (success < 0 && succ + skipped as i64 >= need_s) {
                 out = Status::Success;
                 break;
             }

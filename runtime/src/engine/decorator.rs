@@ -17,6 +17,9 @@ impl<'w> Engine<'w> {
         }
         match (def.op, s) {
             (_, Status::Running) => Status::Running,
+            // BT.CPP 4.10 returns its own status (RUNNING) for a SKIPPED
+            // child; the others pass SKIPPED on.
+            (Op::KeepRunningUntilFailure, Status::Skipped) => Status::Running,
             (_, Status::Skipped) => Status::Skipped,
             (Op::Inverter, Status::Success) => self.fail(i, "its child succeeded (Inverter)"),
             (Op::Inverter, _) => Status::Success,
