@@ -165,6 +165,26 @@ fn run_rules(a: &RunArgs, rules: &Path, plan: &Path) -> anyhow::Result<ExitCode>
     execute(a, &doc, Some(Kb::new(&world)), &mut sources, anchor)
 }
 
+/// A BT.CPP XML tree file and the files it `<include>`s, each read into
+/// `sources` so that a diagnostic names the file it is about.
+fn xml_with_includes(
+    tree: &Path,
+    file: FileId,
+    sources: &mut Sources,
+) -> Result<TreeDoc, btc_runtime::include::Located<FileId>> {
+    use btc_runtime::include::{self, Opened};
+    let first = Opened {
+        file,
+        text: sources.text(file).to_owned(),
+    };
+    let mut open = |p: &Path| -> Result<Opened<FileId>, String> {
+        let text = files::read_text(p)?;
+        let file = sources.add(p.display().to_string(), text.clone());
+        Ok(Opened { file, text })
+    };
+    include::load(tree, first, &mut open)
+}
+
 fn run_tree(a: &RunArgs, tree: &Path) -> anyhow::Result<ExitCode> {
     let mut sources = Sources::new();
     let mut diags = Vec::new();
@@ -172,9 +192,19 @@ fn run_tree(a: &RunArgs, tree: &Path) -> anyhow::Result<ExitCode> {
     if has_errors(&diags) {
         return fail(&diags, &sources, a.format);
     }
-    let loaded = match btc_runtime::load_tree(sources.text(file)) {
-        Ok(x) => x,
-        Err(e) => return fail(&[diagnostic(&e, file, &sources)], &sources, a.format),
+    let loaded = if sources.text(file).trim_start().starts_with('<') {
+        match xml_with_includes(tree, file, &mut sources) {
+            Ok(doc) => Loaded::Xml(doc),
+            Err(l) => {
+                let d = diagnostic(&l.error, l.file, &sources);
+                return fail(&[d], &sources, a.format);
+            }
+        }
+    } else {
+        match btc_runtime::load_tree(sources.text(file)) {
+            Ok(x) => x,
+            Err(e) => return fail(&[diagnostic(&e, file, &sources)], &sources, a.format),
+        }
     };
     // The world: a JSON IR carries it (unless `--problem` names another);
     // XML, and version-1 IR, run in the world of PDDL files.

@@ -529,3 +529,23 @@ fn computed_values_reach_the_engine_from_the_ir_and_from_the_xml() {
         assert_eq!(got, expected, "{what}");
     }
 }
+
+#[test]
+fn an_xml_tree_runs_with_the_trees_it_includes() {
+    // main.xml includes parts/pick.xml, which includes ../count.xml; run
+    // from another folder, the paths stay relative to each file.
+    let out = btc(&[
+        "run",
+        "--tree",
+        "runtime/tests/fixtures/include/main.xml",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(summary(&out)["status"], "SUCCESS");
+}

@@ -346,6 +346,10 @@ pub mod codes {
         X_REPLAN_LIMIT = "X009", "a closed loop that stopped at its replan or tick limit";
         X_WORLD = "X010", "a JSON IR whose world is missing or does not fit together";
         X_BTLOG = "X030", "a run that a Groot2 `.btlog` file cannot hold";
+        X_SCRIPT = "X040", "a BT.CPP script that does not parse";
+        X_UNSUPPORTED = "X041", "a BT.CPP XML construct btc does not run";
+        X_INCLUDE_READ = "X042", "an `<include>` whose file cannot be read";
+        X_INCLUDE_CYCLE = "X043", "an `<include>` that includes itself, or nests too deep";
         // The C++ executor for BehaviorTree.CPP (`btc executor`)
         C_CLASS_NAME = "C001", "a node whose name cannot become a C++ class of the executor";
         C_REGISTERED = "C002", "a node that BehaviorTree.CPP or btc's support library registers already";

@@ -4,11 +4,17 @@
 //! - a ReactiveSequence of one condition over a Sequence of 100 actions
 //!   (the ARIAC monitor shape), with actions that finish at once and with
 //!   actions that run for a tick, and with a KB condition;
-//! - loading a 10,000-node BT.CPP XML tree (target: under 10 ms).
+//! - loading a 10,000-node BT.CPP XML tree (target: under 10 ms);
+//! - #14's figures against real BehaviorTree.CPP 4.10 in the same run
+//!   (`integrations/btcpp/harness/peer.cpp`, built by
+//!   `btc_testkit::btcpp_harness`; skipped without a BT.CPP build): 2M leaf
+//!   ticks from XML (target: 20x faster) and a 10,001-node tree loaded and
+//!   run (target: 10x).
 //!
 //! After divan's table, `main` prints the per-leaf figures directly.
 
 use btc_ir::{LeafKind, PortValue};
+use btc_pddl::logic::decode;
 use btc_pddl::pipeline;
 use btc_runtime::spec::{Kind, SNode, TreeDoc};
 use btc_runtime::{xml, Engine, Kb, Options, Status};
@@ -30,6 +36,7 @@ fn node(kind: Kind, children: Vec<SNode>) -> SNode {
         kind,
         name: None,
         children,
+        scripts: Default::default(),
         at: None,
     }
 }
@@ -146,7 +153,10 @@ fn reactive_kb_monitor_over_100_actions(b: Bencher) {
         Kind::Leaf {
             id: "KbHolds".into(),
             kind: None,
-            ports: vec![("formula".into(), PortValue::Text("(at r1 bin1)".into()))],
+            ports: vec![(
+                "formula".into(),
+                PortValue::Formula(decode::formula("(at r1 bin1)").unwrap()),
+            )],
         },
         Vec::new(),
     );
@@ -235,4 +245,109 @@ fn report() {
     }
     let parse = t.elapsed().as_secs_f64() * 1000.0 / runs as f64;
     println!("Load a 10,001-node XML tree: {ms:.2} ms (parse {parse:.2} ms, build the rest)");
+    against_bt_cpp();
+}
+
+/// `Repeat num_cycles=CYCLES` over a Sequence of `n` AlwaysSuccess.
+fn repeat_xml(cycles: usize, n: usize) -> String {
+    let leaves = "<AlwaysSuccess/>".repeat(n);
+    format!(
+        "<root BTCPP_format=\"4\"><BehaviorTree ID=\"Main\"><Repeat num_cycles=\"{cycles}\">\
+         <Sequence>{leaves}</Sequence></Repeat></BehaviorTree></root>"
+    )
+}
+
+/// 10,001 built-in nodes: a Sequence of 100 Sequences of 99 AlwaysSuccess.
+fn wide_xml() -> String {
+    let inner = format!("<Sequence>{}</Sequence>", "<AlwaysSuccess/>".repeat(99));
+    format!(
+        "<root BTCPP_format=\"4\"><BehaviorTree ID=\"Main\"><Sequence>{}</Sequence>\
+         </BehaviorTree></root>",
+        inner.repeat(100)
+    )
+}
+
+/// The median of `runs` timings of `f`, in milliseconds.
+fn median_ms(runs: usize, mut f: impl FnMut()) -> f64 {
+    let mut v: Vec<f64> = (0..runs)
+        .map(|_| {
+            let t = Instant::now();
+            f();
+            t.elapsed().as_secs_f64() * 1000.0
+        })
+        .collect();
+    v.sort_by(f64::total_cmp);
+    v[runs / 2]
+}
+
+/// The peer's figure: the median of `runs` runs of `peer ARGS`.
+fn peer_ms(peer: &std::path::Path, args: &[&str], runs: usize) -> Option<f64> {
+    let mut v = Vec::new();
+    for _ in 0..runs {
+        let out = std::process::Command::new(peer).args(args).output().ok()?;
+        if !out.status.success() {
+            return None;
+        }
+        v.push(
+            String::from_utf8_lossy(&out.stdout)
+                .trim()
+                .parse::<f64>()
+                .ok()?,
+        );
+    }
+    v.sort_by(f64::total_cmp);
+    Some(v[runs / 2])
+}
+
+/// #14's engine figures, each against real BehaviorTree.CPP 4.10 in the
+/// same run: 2M leaf ticks from XML, and a 10,000-node tree loaded and run.
+fn against_bt_cpp() {
+    let text = repeat_xml(2000, 1000);
+    let doc = xml::parse(&text).unwrap();
+    // The ticks alone, as the peer times one `tickOnce`: BT.CPP 4.10's
+    // Repeat hands the flow back after each cycle that started and ended in
+    // one tick, and `tickOnce` ticks again at once; btc ticks again too.
+    let mut runs: Vec<f64> = (0..5)
+        .map(|_| {
+            let mut e = Engine::build(&doc, None, opts(0)).unwrap();
+            let t = Instant::now();
+            assert_eq!(complete(&mut e), 2000);
+            assert_eq!(e.root_status(), Status::Success);
+            t.elapsed().as_secs_f64() * 1000.0
+        })
+        .collect();
+    runs.sort_by(f64::total_cmp);
+    let ours = runs[2];
+    let wide = wide_xml();
+    let ours_load = median_ms(5, || {
+        let d = xml::parse(&wide).unwrap();
+        let mut e = Engine::build(&d, None, opts(0)).unwrap();
+        assert_eq!(e.node_count(), 10_001);
+        assert_eq!(e.tick_once(), Status::Success);
+    });
+    println!(
+        "2M leaf ticks (Repeat 2000 x Sequence of 1000 AlwaysSuccess, from XML): btc {ours:.2} ms"
+    );
+    println!("10,001-node XML tree loaded and run: btc {ours_load:.2} ms");
+    let Some(peer) = btc_testkit::btcpp_harness().map(|d| d.join("btc_peer")) else {
+        println!("BT.CPP: no build to compare with");
+        return;
+    };
+    let file = peer.with_file_name("wide.xml");
+    std::fs::write(&file, &wide).unwrap();
+    let theirs = peer_ms(&peer, &["leaves", "2000", "1000"], 5);
+    let theirs_load = peer_ms(&peer, &["load", &file.to_string_lossy()], 5);
+    match (theirs, theirs_load) {
+        (Some(t), Some(l)) => {
+            println!(
+                "BT.CPP 4.10: 2M leaf ticks {t:.2} ms ({:.1}x btc's time; target 20x)",
+                t / ours
+            );
+            println!(
+                "BT.CPP 4.10: 10,001-node tree loaded and run {l:.2} ms ({:.1}x btc's time; target 10x)",
+                l / ours_load
+            );
+        }
+        _ => println!("BT.CPP: the peer did not run"),
+    }
 }

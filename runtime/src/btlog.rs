@@ -8,7 +8,7 @@
 //! included) with its length in front, the first timestamp (microseconds
 //! since the epoch), and one 9-byte record per status change: 6 bytes of
 //! microseconds since the first timestamp, the node's uid (2 bytes) and
-//! its status (1 byte: IDLE 0, RUNNING 1, SUCCESS 2, FAILURE 3), all little
+//! its status (1 byte: IDLE 0, RUNNING 1, SUCCESS 2, FAILURE 3, SKIPPED 4), all little
 //! endian. Node uids are BT.CPP's: preorder from 1, subtrees expanded where
 //! they are called, as btc's engine numbers its nodes (uid = index + 1).
 //!
@@ -450,6 +450,7 @@ fn code(s: Status) -> u8 {
         Status::Running => 1,
         Status::Success => 2,
         Status::Failure => 3,
+        Status::Skipped => 4,
     }
 }
 
@@ -517,6 +518,7 @@ mod tests {
             kind: Kind::Sequence,
             name: None,
             children: (0..MAX_NODES).map(|_| leaf("AlwaysSuccess")).collect(),
+            scripts: Default::default(),
             at: None,
         };
         let d = doc(root);

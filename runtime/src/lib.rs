@@ -15,7 +15,9 @@ pub mod engine;
 pub mod error;
 pub mod faults;
 pub mod handler;
+pub mod include;
 pub mod kb;
+pub mod script;
 pub mod spec;
 pub mod xml;
 

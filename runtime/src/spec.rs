@@ -24,6 +24,29 @@ pub enum Kind {
     Retry(Amount<i32>),
     Repeat(Amount<i32>),
     Timeout(Amount<u64>),
+    /// `IfThenElse`: a condition child, a then child, an optional else.
+    IfThenElse,
+    /// `WhileDoElse`: the condition is ticked again on every tick.
+    WhileDoElse,
+    /// `Switch2`..`Switch6`: the child whose case equals `variable`, or the
+    /// last (default) child.
+    Switch {
+        variable: PortValue,
+        cases: Vec<PortValue>,
+    },
+    /// `Delay`: the child is ticked once `msec` (simulated) have passed.
+    Delay(u64),
+    /// `RunOnce`: the child runs to completion once; after that the node
+    /// is SKIPPED (`then_skip`) or returns what the child returned.
+    RunOnce {
+        then_skip: bool,
+    },
+    /// `Precondition`: the child runs while the script `code` held when it
+    /// started; otherwise the node returns `otherwise`.
+    Precondition {
+        code: String,
+        otherwise: Verdict,
+    },
     /// A call of a tree with port remapping.
     SubTree {
         id: String,
@@ -47,6 +70,63 @@ pub enum Kind {
         kind: Option<LeafKind>,
         ports: Vec<(String, PortValue)>,
     },
+}
+
+/// A status a node is told to return (`Precondition`'s `else`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Verdict {
+    Success,
+    Failure,
+    Skipped,
+    Running,
+}
+
+/// The scripts BT.CPP runs around any node's tick: preconditions
+/// (`_failureIf`, `_successIf`, `_skipIf`, `_while`, checked in that
+/// order) and post-conditions (`_onSuccess`, `_onFailure`, `_post`,
+/// `_onHalted`). Each is the script's text.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct NodeScripts {
+    pub failure_if: Option<String>,
+    pub success_if: Option<String>,
+    pub skip_if: Option<String>,
+    pub while_: Option<String>,
+    pub on_success: Option<String>,
+    pub on_failure: Option<String>,
+    pub post: Option<String>,
+    pub on_halted: Option<String>,
+}
+
+impl NodeScripts {
+    /// The attribute names, in BT.CPP's order.
+    pub const ATTRIBUTES: [&'static str; 8] = [
+        "_failureIf",
+        "_successIf",
+        "_skipIf",
+        "_while",
+        "_onSuccess",
+        "_onFailure",
+        "_post",
+        "_onHalted",
+    ];
+
+    /// The script of attribute `ATTRIBUTES[k]`.
+    pub fn slot(&mut self, k: usize) -> &mut Option<String> {
+        match k {
+            0 => &mut self.failure_if,
+            1 => &mut self.success_if,
+            2 => &mut self.skip_if,
+            3 => &mut self.while_,
+            4 => &mut self.on_success,
+            5 => &mut self.on_failure,
+            6 => &mut self.post,
+            _ => &mut self.on_halted,
+        }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        *self == NodeScripts::default()
+    }
 }
 
 /// A step's ground conditions, by when they are checked.
@@ -82,6 +162,8 @@ pub struct SNode {
     pub kind: Kind,
     pub name: Option<String>,
     pub children: Vec<SNode>,
+    /// Pre- and post-condition scripts.
+    pub scripts: NodeScripts,
     /// Byte offset of the node in its source file, when it has one.
     pub at: Option<usize>,
 }
@@ -97,6 +179,7 @@ impl SNode {
             },
             name: None,
             children: Vec::new(),
+            scripts: NodeScripts::default(),
             at: None,
         }
     }
@@ -240,6 +323,7 @@ pub fn from_node(n: &Node) -> SNode {
         kind,
         name,
         children,
+        scripts: Default::default(),
         at: None,
     }
 }
@@ -271,6 +355,18 @@ pub fn default_name(k: &Kind) -> &str {
         Kind::Retry(_) => "RetryUntilSuccessful",
         Kind::Repeat(_) => "Repeat",
         Kind::Timeout(_) => "Timeout",
+        Kind::IfThenElse => "IfThenElse",
+        Kind::WhileDoElse => "WhileDoElse",
+        Kind::Switch { cases, .. } => match cases.len() {
+            2 => "Switch2",
+            3 => "Switch3",
+            4 => "Switch4",
+            5 => "Switch5",
+            _ => "Switch6",
+        },
+        Kind::Delay(_) => "Delay",
+        Kind::RunOnce { .. } => "RunOnce",
+        Kind::Precondition { .. } => "Precondition",
         Kind::SubTree { id, .. } => id,
         Kind::Step { .. } => "KbStep",
         Kind::Leaf { id, .. } => id,

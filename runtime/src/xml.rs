@@ -7,9 +7,9 @@
 
 use crate::engine::MAX_DEPTH;
 use crate::error::LoadError;
-use crate::spec::{Amount, Kind, SNode, StepConditions, TreeDoc};
+use crate::spec::{Amount, Kind, NodeScripts, SNode, StepConditions, TreeDoc, Verdict};
 use btc_ir::{LeafKind, NodeModel, PortDirection, PortModel, PortValue};
-use btc_pddl::diagnostic::codes;
+use btc_pddl::diagnostic::{codes, did_you_mean};
 use btc_pddl::logic::decode;
 use quick_xml::events::{BytesStart, Event};
 use quick_xml::Reader;
@@ -104,6 +104,58 @@ fn ports(e: &mut Elem, skip: &[&str]) -> Vec<(String, PortValue)> {
         .collect()
 }
 
+/// The pre- and post-condition attributes (`_skipIf`...), moved out; any
+/// other attribute starting with `_` but `_autoremap` is refused (X041).
+fn node_scripts(e: &mut Elem) -> Result<NodeScripts, LoadError> {
+    let mut scripts = NodeScripts::default();
+    let mut rest = Vec::with_capacity(e.attrs.len());
+    for (k, v) in std::mem::take(&mut e.attrs) {
+        match NodeScripts::ATTRIBUTES.iter().position(|a| *a == k) {
+            Some(i) => *scripts.slot(i) = Some(v),
+            None if k.starts_with('_') && k != "_autoremap" => {
+                let known = NodeScripts::ATTRIBUTES
+                    .iter()
+                    .copied()
+                    .chain(["_autoremap"]);
+                let mut err = LoadError::new(
+                    codes::X_UNSUPPORTED,
+                    format!("<{}>: the attribute `{k}` is not one btc runs", e.name),
+                )
+                .at(e.at);
+                err = err.hint(match did_you_mean(&k, known) {
+                    Some(h) => h,
+                    None => "btc runs the pre- and post-conditions `_failureIf`, `_successIf`, `_skipIf`, `_while`, `_onSuccess`, `_onFailure`, `_post` and `_onHalted`, and SubTree's `_autoremap`".into(),
+                });
+                return Err(err);
+            }
+            None => rest.push((k, v)),
+        }
+    }
+    e.attrs = rest;
+    Ok(scripts)
+}
+
+/// A status named in an attribute (`Precondition`'s `else`).
+fn verdict(e: &Elem, key: &str, default: Verdict) -> Result<Verdict, LoadError> {
+    Ok(match e.get(key).map(str::trim) {
+        None => default,
+        Some("SUCCESS") => Verdict::Success,
+        Some("FAILURE") => Verdict::Failure,
+        Some("SKIPPED") => Verdict::Skipped,
+        Some("RUNNING") => Verdict::Running,
+        Some(v) => {
+            return Err(LoadError::new(
+                codes::X_BAD_PORT,
+                format!(
+                    "<{}>: `{key}=\"{v}\"` is not SUCCESS, FAILURE, SKIPPED or RUNNING",
+                    e.name
+                ),
+            )
+            .at(e.at))
+        }
+    })
+}
+
 /// A `KbStep`'s condition attributes, when it has any.
 fn step_conditions(e: &Elem) -> Result<Option<Box<StepConditions>>, LoadError> {
     let get = |k: &str| pddl(e, k, decode::formula, "a condition");
@@ -115,8 +167,38 @@ fn step_conditions(e: &Elem) -> Result<Option<Box<StepConditions>>, LoadError> {
     Ok((c != StepConditions::default()).then(|| Box::new(c)))
 }
 
+/// BehaviorTree.CPP 4.10's built-in nodes that btc's engine does not run
+/// (`runtime/src/btcpp_builtins.xml` lists them all): refused by name
+/// rather than taken for a node of the embedder's.
+const NOT_RUN: [&str; 12] = [
+    "AsyncFallback",
+    "AsyncSequence",
+    "LoopBool",
+    "LoopDouble",
+    "LoopInt",
+    "LoopString",
+    "ParallelAll",
+    "SkipUnlessUpdated",
+    "TryCatch",
+    "UnsetBlackboard",
+    "WaitValueUpdate",
+    "WasEntryUpdated",
+];
+
 fn node_of(mut e: Elem) -> Result<SNode, LoadError> {
+    if NOT_RUN.contains(&e.name.as_str()) {
+        return Err(LoadError::new(
+            codes::X_UNSUPPORTED,
+            format!(
+                "<{}> is a BehaviorTree.CPP 4.10 node btc does not run",
+                e.name
+            ),
+        )
+        .at(e.at)
+        .hint("docs/runtime.md lists the nodes btc runs"));
+    }
     let name = e.get("name").map(str::to_owned);
+    let scripts = node_scripts(&mut e)?;
     let kind = match e.name.as_str() {
         "Sequence" => Kind::Sequence,
         "ReactiveSequence" => Kind::ReactiveSequence,
@@ -149,6 +231,60 @@ fn node_of(mut e: Elem) -> Result<SNode, LoadError> {
                 })?)
             }
         }),
+        "IfThenElse" => Kind::IfThenElse,
+        "WhileDoElse" => Kind::WhileDoElse,
+        "Switch2" | "Switch3" | "Switch4" | "Switch5" | "Switch6" => {
+            let n: usize = e.name["Switch".len()..].parse().unwrap_or(2);
+            let variable = e.get("variable").map(|v| port_value(v.to_owned()));
+            let variable = variable.ok_or_else(|| {
+                LoadError::new(
+                    codes::X_BAD_PORT,
+                    format!("<{}> needs the attribute `variable`", e.name),
+                )
+                .at(e.at)
+            })?;
+            let cases = (1..=n)
+                .map(|k| {
+                    e.get(&format!("case_{k}"))
+                        .map(|v| port_value(v.to_owned()))
+                        .unwrap_or(PortValue::Text(String::new()))
+                })
+                .collect();
+            Kind::Switch { variable, cases }
+        }
+        "Delay" => {
+            let ms = e.int("delay_msec", None)?;
+            Kind::Delay(u64::try_from(ms).map_err(|_| {
+                LoadError::new(
+                    codes::X_BAD_PORT,
+                    "<Delay>: `delay_msec` must not be negative",
+                )
+                .at(e.at)
+            })?)
+        }
+        "RunOnce" => Kind::RunOnce {
+            then_skip: match e.get("then_skip").map(str::trim) {
+                None | Some("true") | Some("1") => true,
+                Some("false") | Some("0") => false,
+                Some(v) => {
+                    return Err(LoadError::new(
+                        codes::X_BAD_PORT,
+                        format!("<RunOnce>: `then_skip=\"{v}\"` is not true or false"),
+                    )
+                    .at(e.at))
+                }
+            },
+        },
+        "Precondition" => Kind::Precondition {
+            code: e
+                .get("if")
+                .ok_or_else(|| {
+                    LoadError::new(codes::X_BAD_PORT, "<Precondition> needs the attribute `if`")
+                        .at(e.at)
+                })?
+                .to_owned(),
+            otherwise: verdict(&e, "else", Verdict::Failure)?,
+        },
         "SubTree" => {
             let id = e.get("ID").ok_or_else(|| {
                 LoadError::new(codes::X_BAD_PORT, "<SubTree> needs the attribute `ID`").at(e.at)
@@ -215,6 +351,7 @@ fn node_of(mut e: Elem) -> Result<SNode, LoadError> {
         kind,
         name,
         children: Vec::new(),
+        scripts,
         at: Some(e.at),
     })
 }
@@ -314,8 +451,66 @@ enum Place {
     Skip(usize),
 }
 
-/// Parses a BT.CPP v4 XML document.
+/// An `<include path="...">` of a file, as written.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Include {
+    pub path: String,
+    /// Byte offset of the `<include>` element.
+    pub at: usize,
+}
+
+/// One file as read, before its includes are resolved and its main tree
+/// is chosen.
+#[derive(Debug)]
+pub struct Parsed {
+    /// Its trees and models (`main` still empty).
+    pub doc: TreeDoc,
+    /// Its `main_tree_to_execute`.
+    pub main: Option<String>,
+    pub includes: Vec<Include>,
+}
+
+/// Parses a BT.CPP v4 XML document that includes no other file (a tree
+/// read from text has no folder to find them in; [`crate::include::load`]
+/// reads a file and what it includes).
 pub fn parse(text: &str) -> Result<TreeDoc, LoadError> {
+    let p = parse_file(text)?;
+    if let Some(inc) = p.includes.first() {
+        return Err(LoadError::new(
+            codes::X_INCLUDE_READ,
+            format!(
+                "<include path=\"{}\">: this tree is read as text, with no folder to find the file in",
+                inc.path
+            ),
+        )
+        .at(inc.at)
+        .hint("run the tree from its file (`btc run --tree FILE`)"));
+    }
+    finish(p.doc, p.main)
+}
+
+/// The document's main tree: `main_tree_to_execute`, or its only tree.
+pub fn finish(mut doc: TreeDoc, main: Option<String>) -> Result<TreeDoc, LoadError> {
+    doc.main = match main {
+        Some(m) => m,
+        None if doc.trees.len() == 1 => doc.trees[0].0.clone(),
+        None => {
+            return Err(syntax("<root> does not say which tree to run", 0)
+                .hint("add `main_tree_to_execute=\"ID\"` to <root>"))
+        }
+    };
+    if doc.tree(&doc.main).is_none() {
+        return Err(LoadError::new(
+            codes::X_SUBTREE,
+            format!("the main tree `{}` is not defined in this file", doc.main),
+        ));
+    }
+    Ok(doc)
+}
+
+/// Parses one BT.CPP v4 XML file: its trees, models and includes.
+pub fn parse_file(text: &str) -> Result<Parsed, LoadError> {
+    let mut includes = Vec::new();
     let mut r = Reader::from_str(text);
     r.config_mut().trim_text(true);
     let mut doc = TreeDoc::default();
@@ -383,10 +578,29 @@ pub fn parse(text: &str) -> Result<TreeDoc, LoadError> {
                         }
                     }
                     "include" => {
-                        return Err(syntax(
-                            "<include> is not supported: put every tree in one file",
+                        if e.get("ros_pkg").is_some() {
+                            return Err(LoadError::new(
+                                codes::X_UNSUPPORTED,
+                                "<include ros_pkg>: btc does not look up ROS packages",
+                            )
+                            .at(at)
+                            .hint("give `path` relative to this file, without `ros_pkg`"));
+                        }
+                        let path = e.get("path").map(str::trim).filter(|p| !p.is_empty());
+                        let Some(path) = path else {
+                            return Err(LoadError::new(
+                                codes::X_INCLUDE_READ,
+                                "<include> needs the attribute `path`",
+                            )
+                            .at(at));
+                        };
+                        includes.push(Include {
+                            path: path.to_owned(),
                             at,
-                        ))
+                        });
+                        if !empty {
+                            place = Place::Skip(1);
+                        }
                     }
                     _ => {
                         if !empty {
@@ -488,21 +702,11 @@ pub fn parse(text: &str) -> Result<TreeDoc, LoadError> {
     if !saw_root {
         return Err(syntax("this file has no <root> element", 0));
     }
-    doc.main = match main {
-        Some(m) => m,
-        None if doc.trees.len() == 1 => doc.trees[0].0.clone(),
-        None => {
-            return Err(syntax("<root> does not say which tree to run", 0)
-                .hint("add `main_tree_to_execute=\"ID\"` to <root>"))
-        }
-    };
-    if doc.tree(&doc.main).is_none() {
-        return Err(LoadError::new(
-            codes::X_SUBTREE,
-            format!("the main tree `{}` is not defined in this file", doc.main),
-        ));
-    }
-    Ok(doc)
+    Ok(Parsed {
+        doc,
+        main,
+        includes,
+    })
 }
 
 #[cfg(test)]
@@ -533,7 +737,24 @@ mod tests {
         let e = parse("<root BTCPP_format=\"3\"></root>").unwrap_err();
         assert_eq!(e.code.id, "X001");
         let e = parse("<root><include path=\"x.xml\"/></root>").unwrap_err();
-        assert!(e.message.contains("include"));
+        assert_eq!(e.code.id, "X042");
+        let e = parse("<root><include ros_pkg=\"p\" path=\"x.xml\"/></root>").unwrap_err();
+        assert_eq!(e.code.id, "X041");
+    }
+
+    #[test]
+    fn bt_cpp_nodes_btc_does_not_run_are_refused_by_name() {
+        for id in NOT_RUN {
+            let text = format!(
+                "<root BTCPP_format=\"4\"><BehaviorTree ID=\"M\"><{id}/></BehaviorTree></root>"
+            );
+            let e = parse(&text).unwrap_err();
+            assert_eq!(e.code.id, "X041", "{id}");
+            assert_eq!(
+                e.message,
+                format!("<{id}> is a BehaviorTree.CPP 4.10 node btc does not run")
+            );
+        }
     }
 
     #[test]

@@ -38,6 +38,7 @@ fn letter(s: Status) -> char {
         Status::Running => 'R',
         Status::Success => 'S',
         Status::Failure => 'F',
+        Status::Skipped => 'K',
     }
 }
 
@@ -234,6 +235,10 @@ fn compare(case: &Case, btc: &Run, cpp: &Run) -> Result<(), String> {
 struct Gen {
     rng: fastrand::Rng,
     subtrees: Vec<String>,
+    /// Also BT.CPP's scripting and the nodes around it: Script,
+    /// ScriptCondition, IfThenElse, WhileDoElse, Switch2, RunOnce,
+    /// Precondition, and the pre- and post-condition attributes.
+    scripting: bool,
 }
 
 const KEYS: &[&str] = &["a", "b", "c"];
@@ -254,7 +259,67 @@ impl Gen {
         KEYS[self.rng.usize(..KEYS.len())]
     }
 
+    /// An entry a script may read: one every tree sets first. Scripts keep
+    /// to entries of their own (`x`, `y`): BT.CPP 4.10 throws (out of
+    /// `tickExactlyOnce`, uncaught) when a typed port reads an entry a
+    /// script created.
+    fn script_key(&mut self, _params: &[&str]) -> &'static str {
+        if self.rng.bool() {
+            "x"
+        } else {
+            "y"
+        }
+    }
+
+    /// A tree's root: with scripting, after the script that makes the
+    /// entries scripts read.
+    fn root(&mut self, out: &mut String, params: &[&str]) {
+        if self.scripting {
+            out.push_str(r#"<Sequence><Script code="x := 'S'; y := 'F'"/>"#);
+            self.node(out, 1, params);
+            out.push_str("</Sequence>");
+        } else {
+            self.node(out, if params.is_empty() { 0 } else { 1 }, params);
+        }
+    }
+
+    /// A condition on an entry (entries hold status letters).
+    fn condition(&mut self, params: &[&str]) -> String {
+        let k = self.script_key(params);
+        let s = self.script();
+        let op = if self.rng.bool() { "==" } else { "!=" };
+        format!("{k} {op} '{s}'")
+    }
+
+    /// Sometimes a pre- or post-condition attribute.
+    fn guard(&mut self, params: &[&str]) -> String {
+        if !self.scripting || self.rng.u8(0..100) >= 20 {
+            return String::new();
+        }
+        let attr = ["_skipIf", "_successIf", "_failureIf", "_while"][self.rng.usize(..4)];
+        let c = self.condition(params);
+        let mut g = format!(r#" {attr}="{c}""#);
+        if self.rng.bool() {
+            let post = ["_onSuccess", "_onFailure", "_post", "_onHalted"][self.rng.usize(..4)];
+            let k = self.script_key(params);
+            let s = self.script();
+            let _ = write!(g, r#" {post}="{k} := '{s}'""#);
+        }
+        g
+    }
+
     fn leaf(&mut self, out: &mut String, params: &[&str]) {
+        if self.scripting && self.rng.u8(0..100) < 20 {
+            let k = self.script_key(params);
+            if self.rng.bool() {
+                let s = self.script();
+                let _ = write!(out, r#"<Script code="{k} := '{s}'"/>"#);
+            } else {
+                let c = self.condition(params);
+                let _ = write!(out, r#"<ScriptCondition code="{c}"/>"#);
+            }
+            return;
+        }
         match self.rng.u8(0..100) {
             0..=44 => {
                 let s = self.script();
@@ -300,6 +365,43 @@ impl Gen {
             }
             return;
         }
+        if self.scripting && r < 50 {
+            let g = self.guard(params);
+            let (tag, n, extra) = match self.rng.u8(0..3) {
+                0 => ("IfThenElse", self.rng.usize(2..=3), String::new()),
+                1 => ("WhileDoElse", self.rng.usize(2..=3), String::new()),
+                _ => {
+                    let k = self.script_key(params);
+                    let (a, b) = (self.script(), self.script());
+                    (
+                        "Switch2",
+                        3,
+                        format!(r#" variable="{{{k}}}" case_1="{a}" case_2="{b}""#),
+                    )
+                }
+            };
+            let _ = write!(out, "<{tag}{extra}{g}>");
+            for _ in 0..n {
+                self.node(out, depth + 1, params);
+            }
+            let _ = write!(out, "</{tag}>");
+            return;
+        }
+        if self.scripting && r < 60 {
+            let g = self.guard(params);
+            let (tag, extra) = if self.rng.bool() {
+                let skip = if self.rng.bool() { "true" } else { "false" };
+                ("RunOnce", format!(r#" then_skip="{skip}""#))
+            } else {
+                let c = self.condition(params);
+                let e = ["SUCCESS", "FAILURE", "SKIPPED"][self.rng.usize(..3)];
+                ("Precondition", format!(r#" if="{c}" else="{e}""#))
+            };
+            let _ = write!(out, "<{tag}{extra}{g}>");
+            self.node(out, depth + 1, params);
+            let _ = write!(out, "</{tag}>");
+            return;
+        }
         if r < 75 {
             let n = self.rng.usize(1..=4);
             let (tag, extra) = match self.rng.u8(0..6) {
@@ -321,7 +423,8 @@ impl Gen {
                     ("Parallel", s + &f)
                 }
             };
-            let _ = write!(out, "<{tag}{extra}>");
+            let g = self.guard(params);
+            let _ = write!(out, "<{tag}{extra}{g}>");
             for _ in 0..n {
                 self.node(out, depth + 1, params);
             }
@@ -363,12 +466,12 @@ impl Gen {
         for i in 0..self.rng.usize(0..=2) {
             let id = format!("S{i}");
             let _ = write!(defs, r#"<BehaviorTree ID="{id}">"#);
-            self.node(&mut defs, 1, &["s"]);
+            self.root(&mut defs, &["s"]);
             defs.push_str("</BehaviorTree>");
             self.subtrees.push(id);
         }
         let mut main = String::from(r#"<BehaviorTree ID="Main">"#);
-        self.node(&mut main, 0, &[]);
+        self.root(&mut main, &[]);
         main.push_str("</BehaviorTree>");
         format!(
             r#"<root BTCPP_format="4" main_tree_to_execute="Main">{main}{defs}<TreeNodesModel><Action ID="Scripted"><input_port name="script" type="std::string"/></Action></TreeNodesModel></root>"#
@@ -425,13 +528,16 @@ fn check_all(cases: &[Case], name: &str) -> usize {
     finished
 }
 
-#[test]
-fn random_trees_run_tick_for_tick_as_in_btcpp() {
-    let n = env_or("BTC_CONFORMANCE_CASES", 10_000) as usize;
-    let seed = env_or("BTC_CONFORMANCE_SEED", 0x6274_6370_7034);
+/// A random batch (`BTC_CONFORMANCE_CASES` and `BTC_CONFORMANCE_SEED`
+/// override `n` and `seed`), checked against BT.CPP: it must not be
+/// trivial (most trees finish, some run on).
+fn random_batch(name: &str, n: u64, seed: u64, scripting: bool) {
+    let n = env_or("BTC_CONFORMANCE_CASES", n) as usize;
+    let seed = env_or("BTC_CONFORMANCE_SEED", seed);
     let mut g = Gen {
         rng: fastrand::Rng::with_seed(seed),
         subtrees: Vec::new(),
+        scripting,
     };
     let cases: Vec<Case> = (0..n)
         .map(|_| Case {
@@ -442,14 +548,27 @@ fn random_trees_run_tick_for_tick_as_in_btcpp() {
             tick_ms: 0,
         })
         .collect();
-    let finished = check_all(&cases, "random");
+    let finished = check_all(&cases, name);
     if harness().is_some() {
-        // The batch is not trivial: most trees finish, some run on.
         assert!(
             finished > n / 3 && finished < n,
             "{finished} of {n} finished"
         );
     }
+}
+
+#[test]
+fn random_trees_run_tick_for_tick_as_in_btcpp() {
+    random_batch("random", 10_000, 0x6274_6370_7034, false);
+}
+
+/// Not yet green: 61 of the 5,000 cases still differ (some where BT.CPP
+/// 4.10 throws: IfThenElse with a SKIPPED condition, WhileDoElse setting
+/// IDLE). Run with `--ignored`; the first differences are printed.
+#[test]
+#[ignore = "61 of 5,000 scripting cases still differ from BT.CPP 4.10"]
+fn random_trees_with_scripting_run_tick_for_tick_as_in_btcpp() {
+    random_batch("scripting", 5_000, 0x7363_7269_7074, true);
 }
 
 fn one(xml_body: &str, ticks: u32, tick_ms: u64) -> Case {
@@ -662,6 +781,7 @@ fn btc_run_btlog_has_the_structure_btcpp_filelogger2_writes() {
     let mut g = Gen {
         rng: fastrand::Rng::with_seed(0x0062_746c_6f67),
         subtrees: Vec::new(),
+        scripting: false,
     };
     let cases: Vec<Case> = (0..300)
         .map(|_| Case {

@@ -48,6 +48,7 @@ fn leaf(i: usize) -> SNode {
         },
         name: Some(format!("work {i}")),
         children: Vec::new(),
+        scripts: Default::default(),
         at: None,
     }
 }
@@ -70,6 +71,7 @@ fn a_wide_parallel_issues_each_command_once_under_back_pressure() {
         },
         name: None,
         children: (0..n).map(leaf).collect(),
+        scripts: Default::default(),
         at: None,
     };
     let mut e = Engine::build(&doc(root), None, Options::default()).unwrap();
@@ -93,6 +95,7 @@ fn a_sequence_waits_for_each_completion_in_turn() {
         kind: Kind::Sequence,
         name: None,
         children: (0..50).map(leaf).collect(),
+        scripts: Default::default(),
         at: None,
     };
     let mut e = Engine::build(&doc(root), None, Options::default()).unwrap();
@@ -112,6 +115,7 @@ fn dropping_an_engine_with_commands_in_flight_shuts_down_cleanly() {
         },
         name: None,
         children: (0..20).map(leaf).collect(),
+        scripts: Default::default(),
         at: None,
     };
     let mut e = Engine::build(&doc(root), None, Options::default()).unwrap();
@@ -135,6 +139,7 @@ fn halted_leaves_commands_still_run_once_and_are_not_waited_for() {
         },
         name: None,
         children: Vec::new(),
+        scripts: Default::default(),
         at: None,
     };
     let par = SNode {
@@ -144,12 +149,14 @@ fn halted_leaves_commands_still_run_once_and_are_not_waited_for() {
         },
         name: None,
         children: vec![sleep, leaf(0)],
+        scripts: Default::default(),
         at: None,
     };
     let root = SNode {
         kind: Kind::Repeat(btc_runtime::spec::Amount::Fixed(3)),
         name: None,
         children: vec![par],
+        scripts: Default::default(),
         at: None,
     };
     let mut e = Engine::build(

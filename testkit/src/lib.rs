@@ -285,7 +285,8 @@ pub fn cmake_build(
 }
 
 /// The build folder of btc's C++ test harnesses
-/// (`integrations/btcpp/harness/`: `btc_conformance`, `btc_kb_eval`), built
+/// (`integrations/btcpp/harness/`: `btc_conformance`, `btc_kb_eval`,
+/// `btc_peer`), built
 /// once per test process against [`btcpp`]; `None` after [`skip`]. A build
 /// that fails is a test failure, not a skip.
 pub fn btcpp_harness() -> Option<PathBuf> {
@@ -298,7 +299,7 @@ pub fn btcpp_harness() -> Option<PathBuf> {
             &build,
             &prefix,
             &[],
-            &["btc_conformance", "btc_kb_eval"],
+            &["btc_conformance", "btc_kb_eval", "btc_peer"],
         )
         .map(|()| build)
     });

@@ -1,0 +1,106 @@
+//! Plan steps: a step node wraps the subtree of one plan step; it checks
+//! the step's conditions and applies its effects to the KB.
+
+use super::record::Reason;
+use super::{Engine, NodeDef, Status, TraceItem};
+use crate::kb::{EffectId, FormulaId};
+
+/// A plan step at run time.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct StepRt {
+    pub label: String,
+    pub pre_start: Option<FormulaId>,
+    pub pre_over_all: Option<FormulaId>,
+    pub pre_end: Option<FormulaId>,
+    pub eff_start: Option<EffectId>,
+    pub eff_end: Option<EffectId>,
+    pub skipped: bool,
+    pub started: bool,
+    pub finished: bool,
+}
+
+impl StepRt {
+    /// What an action leaf of the step checks when it starts: the
+    /// precondition, or (when at-start effects already changed the KB) the
+    /// over-all condition.
+    pub fn leaf_check(&self) -> Option<FormulaId> {
+        if self.eff_start.is_some() {
+            self.pre_over_all
+        } else {
+            self.pre_start.or(self.pre_over_all)
+        }
+    }
+}
+
+impl<'w> Engine<'w> {
+    pub(super) fn tick_step(&mut self, i: u32, def: NodeDef, k: u32) -> Status {
+        let iu = i as usize;
+        let ku = k as usize;
+        if self.status[iu] != Status::Running {
+            self.set(iu, Status::Running);
+            if !self.faults.is_empty() {
+                self.faults_on_step(ku);
+            }
+            self.step_running = Some(k);
+            if self.opts.trace {
+                self.trace.push(TraceItem::StepStarted {
+                    tick: self.tick,
+                    step: k,
+                });
+            }
+            if let Some(st) = self.steps.get(ku) {
+                // With at-start effects, the precondition is checked before
+                // they apply; otherwise the step's action leaves check it.
+                if st.eff_start.is_some() {
+                    if let (Some(pre), Some(kb)) = (st.pre_start, self.kb.as_ref()) {
+                        if !kb.holds(pre) {
+                            self.note_failure(i, Reason::Precondition(pre));
+                            return Status::Failure;
+                        }
+                    }
+                }
+                if !st.started {
+                    let eff = st.eff_start;
+                    self.steps[ku].started = true;
+                    if let (Some(e), Some(kb)) = (eff, self.kb.as_mut()) {
+                        kb.apply(e);
+                    }
+                }
+            }
+        }
+        let c = self.kid(def, 0);
+        let s = self.tick_node(c);
+        if !s.is_done() {
+            return s;
+        }
+        self.reset(c);
+        if s == Status::Failure {
+            return s;
+        }
+        if let Some(st) = self.steps.get(ku) {
+            if let (Some(pre), Some(kb)) = (st.pre_end, self.kb.as_ref()) {
+                if !kb.holds(pre) {
+                    self.note_failure(i, Reason::EndCondition(pre));
+                    return Status::Failure;
+                }
+            }
+            if !st.finished {
+                let eff = st.eff_end;
+                self.steps[ku].finished = true;
+                if self.step_running == Some(k) {
+                    self.step_running = None;
+                }
+                if let (Some(e), Some(kb)) = (eff, self.kb.as_mut()) {
+                    kb.apply(e);
+                }
+                if self.opts.trace {
+                    self.trace.push(TraceItem::StepFinished {
+                        tick: self.tick,
+                        step: k,
+                    });
+                }
+            }
+        }
+        Status::Success
+    }
+}
