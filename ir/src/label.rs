@@ -54,6 +54,23 @@ impl Label {
         Some(out)
     }
 
+    /// The name with each parameter as `{param}`, for an executor that
+    /// fills names from each call's arguments (the py_trees runtime).
+    pub fn braced(&self) -> String {
+        let mut out = String::new();
+        for p in &self.parts {
+            match p {
+                LabelPart::Text(t) => out.push_str(t),
+                LabelPart::Param(p) => {
+                    out.push('{');
+                    out.push_str(p);
+                    out.push('}');
+                }
+            }
+        }
+        out
+    }
+
     /// The parameters it reads, in order.
     pub fn params(&self) -> impl Iterator<Item = &str> {
         self.parts.iter().filter_map(|p| match p {

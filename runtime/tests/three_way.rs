@@ -24,13 +24,11 @@ use std::process::Command;
 const MAX_TICKS: u64 = 100_000;
 
 /// Jobs on which all executions agree but do not reach the goal, because
-/// of the tree btc compiles, not of a target: `steps backchained` takes a
-/// conjunct over a derived predicate as achieved by any step that changes
-/// something (lang/src/lower/backchain.rs, `Opaque::touched_by`), so its
-/// "not needed?" test skips `(link s1 cam1)`, which `(not (cut_off cam1))`
-/// needs, and step 5 `(calibrate cam1)` then never gets ready. An entry that starts reaching
-/// its goal fails this test, so the list cannot outlive the bug.
-const KNOWN_UNREACHED: &[&str] = &["feature_sensors_backchained_btrules"];
+/// of the tree btc compiles, not of a target. An entry that starts
+/// reaching its goal fails this test, so the list cannot outlive its
+/// cause. (Empty since `steps backchained` skips a step only when a later
+/// stage's sufficient condition holds.)
+const KNOWN_UNREACHED: &[&str] = &[];
 
 /// What a run ends with, in the form all three executions can give.
 #[derive(Debug, PartialEq, serde::Deserialize)]

@@ -552,9 +552,10 @@ fn push_indent(o: &mut String, levels: usize) {
     }
 }
 
+/// A node's name; the module fills a tree's parameters in at each call.
 fn opt_name(name: &Option<Label>) -> String {
     name.as_ref()
-        .map_or_else(|| "None".into(), |n| py_str(&n.to_string()))
+        .map_or_else(|| "None".into(), |n| py_str(&n.braced()))
 }
 
 /// `(("port", value), ...)`

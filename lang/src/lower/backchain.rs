@@ -87,8 +87,11 @@ type Condition = BTreeSet<Part>;
 
 /// The conjuncts that are not literals, with the predicates they read. Such
 /// a conjunct regresses unchanged through a step whose effects touch none
-/// of them; a step that touches one is taken to achieve it (it is checked
-/// where it is needed: by the goal, or by the step whose condition it is).
+/// of them. Through a step that touches one, what it needs before the step
+/// is not known: the necessary condition drops it (the step may achieve
+/// it; it is checked where it is needed, by the goal or by the step whose
+/// condition it is), the sufficient condition becomes false (nothing
+/// before the step guarantees it).
 #[derive(Default)]
 struct Opaque {
     /// The conjunct, the predicates it reads, whether it reads a derived
@@ -159,30 +162,47 @@ fn condition(f: &Formula, derived: &BTreeSet<Name>, opaque: &mut Opaque) -> Vec<
     out
 }
 
+/// Which remaining-plan condition a regression computes.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Bound {
+    /// What must hold for the rest of the plan to run: a conjunct a step
+    /// may achieve in ways regression cannot follow is dropped.
+    Necessary,
+    /// What guarantees the rest of the plan runs: such a conjunct makes
+    /// it false (`None`).
+    Sufficient,
+}
+
 /// `r` regressed through effect `eff`: literals the effect makes true are
 /// dropped; a literal it makes false cannot hold after it (`Err` names it;
 /// a valid plan never does this); a literal or conjunct over a predicate
-/// its quantified or conditional parts change is taken as achieved.
-fn regress(r: &Condition, eff: &StepEffect, opaque: &Opaque) -> Result<Condition, Literal> {
+/// its quantified or conditional parts change, or over a derived one it
+/// may change, is dropped or makes the condition false, by `bound`.
+fn regress(
+    r: &Condition,
+    eff: &StepEffect,
+    opaque: &Opaque,
+    bound: Bound,
+) -> Result<Option<Condition>, Literal> {
     let mut out = Condition::new();
     for p in r {
-        match p {
+        let touched = match p {
             Part::Lit(l) => match eff.lits.iter().find(|e| e.atom == l.atom) {
-                Some(e) if e.positive == l.positive => {}
+                Some(e) if e.positive == l.positive => continue,
                 Some(_) => return Err(l.clone()),
-                None if eff.touched.contains(&l.atom.pred) => {}
-                None => {
-                    out.insert(p.clone());
-                }
+                None => eff.touched.contains(&l.atom.pred),
             },
-            Part::Opaque(i) => {
-                if !opaque.touched_by(*i, eff) {
-                    out.insert(p.clone());
-                }
+            Part::Opaque(i) => opaque.touched_by(*i, eff),
+        };
+        match (touched, bound) {
+            (false, _) => {
+                out.insert(p.clone());
             }
+            (true, Bound::Necessary) => {}
+            (true, Bound::Sufficient) => return Ok(None),
         }
     }
-    Ok(out)
+    Ok(Some(out))
 }
 
 /// One step's conditions as parts and effects as outcomes.
@@ -211,21 +231,34 @@ fn plain_step(info: &StepInfo, derived: &BTreeSet<Name>, opaque: &mut Opaque) ->
 }
 
 /// `R_0 ..= R_m` for `steps` (the plan's steps that are not skipped, in
-/// order); `Err((i, literal))` when step `i` makes false a literal that
-/// the rest of the plan needs.
+/// order), each `None` where it is false; `Err((i, literal))` when step
+/// `i` makes false a literal that the rest of the plan needs.
 fn remaining(
     goal: &[Part],
     steps: &[PlainStep],
     opaque: &Opaque,
-) -> Result<Vec<Condition>, (usize, Literal)> {
-    let mut conds = vec![Condition::new(); steps.len() + 1];
-    let mut r: Condition = goal.iter().cloned().collect();
+    bound: Bound,
+) -> Result<Vec<Option<Condition>>, (usize, Literal)> {
+    let mut conds = vec![None; steps.len() + 1];
+    let mut r: Option<Condition> = Some(goal.iter().cloned().collect());
     conds[steps.len()] = r.clone();
     for (i, s) in steps.iter().enumerate().rev() {
-        let mut next = regress(&r, &s.eff_end, opaque).map_err(|l| (i, l))?;
+        let Some(after) = &r else {
+            // False stays false through every earlier step.
+            break;
+        };
+        let mut next = match regress(after, &s.eff_end, opaque, bound).map_err(|l| (i, l))? {
+            Some(c) => c,
+            None => {
+                r = None;
+                continue;
+            }
+        };
         next.extend(s.pre_later.iter().cloned());
-        r = regress(&next, &s.eff_start, opaque).map_err(|l| (i, l))?;
-        r.extend(s.pre_start.iter().cloned());
+        r = regress(&next, &s.eff_start, opaque, bound).map_err(|l| (i, l))?;
+        if let Some(c) = r.as_mut() {
+            c.extend(s.pre_start.iter().cloned());
+        }
         conds[i] = r.clone();
     }
     Ok(conds)
@@ -288,15 +321,24 @@ pub(super) fn stages(
         .iter()
         .map(|(_, info)| plain_step(info, derived, &mut opaque))
         .collect::<Vec<_>>();
-    let conds = remaining(&goal, &plain, &opaque).map_err(|(i, l)| Breaks {
+    let breaks = |(i, l): (usize, Literal)| Breaks {
         step: run[i].1.index,
         what: l.to_formula().to_string(),
-    })?;
+    };
+    // Necessary conditions never become false.
+    let conds: Vec<Condition> = remaining(&goal, &plain, &opaque, Bound::Necessary)
+        .map_err(breaks)?
+        .into_iter()
+        .map(Option::unwrap_or_default)
+        .collect();
+    let enough = remaining(&goal, &plain, &opaque, Bound::Sufficient).map_err(breaks)?;
     let mut out = Vec::with_capacity(run.len());
     for (i, (node, info)) in run.into_iter().enumerate() {
         let label = info.index + 1;
-        let later: Vec<&Condition> = conds[i + 1..].iter().collect();
-        let not_needed = any_of(&later, &opaque);
+        // A step is skipped only when a later stage is sure to finish the
+        // plan; it is tried when the rest of the plan may still run.
+        let later: Vec<&Condition> = enough[i + 1..].iter().flatten().collect();
+        let not_needed = (!later.is_empty()).then(|| any_of(&later, &opaque));
         let ready = to_formula(&conds[i], &opaque);
         // Before the first step: whether the plan can resume from here at
         // all, so a state none of its steps can continue from fails with
@@ -312,17 +354,18 @@ pub(super) fn stages(
         out.push(Node::Control {
             control: ControlKind::Fallback,
             name: Some(format!("step {label} {}", info.display()).into()),
-            children: vec![
-                kb_holds(not_needed, Some(format!("step {label} not needed?"))),
-                Node::Control {
+            children: not_needed
+                .map(|f| kb_holds(f, Some(format!("step {label} not needed?"))))
+                .into_iter()
+                .chain([Node::Control {
                     control: ControlKind::Sequence,
                     name: None,
                     children: first
                         .into_iter()
                         .chain([kb_holds(ready, Some(format!("step {label} ready?"))), node])
                         .collect(),
-                },
-            ],
+                }])
+                .collect(),
         });
     }
     Ok(out)
@@ -370,8 +413,10 @@ mod tests {
         );
         let goal = vec![Part::Lit(lit(true, "calibrated", &["i"]))];
         let none = Opaque::default();
-        let conds = remaining(&goal, &[on, cal], &none).ok().unwrap();
-        let show = |c: &Condition| to_formula(c, &none).to_string();
+        let conds = remaining(&goal, &[on, cal], &none, Bound::Sufficient)
+            .ok()
+            .unwrap();
+        let show = |c: &Option<Condition>| to_formula(c.as_ref().unwrap(), &none).to_string();
         assert_eq!(show(&conds[2]), "(calibrated i)");
         assert_eq!(show(&conds[1]), "(power_on i)");
         assert_eq!(show(&conds[0]), "(power_avail s)");
@@ -381,7 +426,9 @@ mod tests {
     fn a_step_that_breaks_what_later_steps_need_makes_the_regression_unsatisfiable() {
         let s = step(Vec::new(), vec![lit(false, "p", &[])]);
         let goal = [Part::Lit(lit(true, "p", &[]))];
-        let err = remaining(&goal, &[s], &Opaque::default()).err().unwrap();
+        let err = remaining(&goal, &[s], &Opaque::default(), Bound::Necessary)
+            .err()
+            .unwrap();
         assert_eq!(err, (0, lit(true, "p", &[])));
     }
 
@@ -400,12 +447,24 @@ mod tests {
         let mut opaque = Opaque::default();
         let f = btc_pddl::logic::decode::formula("(forall (?x) (q ?x))").unwrap();
         let goal = vec![opaque.add(&f, &BTreeSet::new())];
-        let touches = step(Vec::new(), vec![lit(true, "q", &["a"])]);
-        let other = step(Vec::new(), vec![lit(true, "p", &[])]);
-        let conds = remaining(&goal, &[touches, other], &opaque).ok().unwrap();
-        let show = |c: &Condition| to_formula(c, &opaque).to_string();
-        assert_eq!(show(&conds[2]), "(forall (?x) (q ?x))");
-        assert_eq!(show(&conds[1]), "(forall (?x) (q ?x))");
-        assert_eq!(show(&conds[0]), "(and)");
+        let steps = || {
+            [
+                step(Vec::new(), vec![lit(true, "q", &["a"])]),
+                step(Vec::new(), vec![lit(true, "p", &[])]),
+            ]
+        };
+        let show = |c: &Option<Condition>| c.as_ref().map(|c| to_formula(c, &opaque).to_string());
+        let may = remaining(&goal, &steps(), &opaque, Bound::Necessary)
+            .ok()
+            .unwrap();
+        assert_eq!(show(&may[2]).unwrap(), "(forall (?x) (q ?x))");
+        assert_eq!(show(&may[1]).unwrap(), "(forall (?x) (q ?x))");
+        assert_eq!(show(&may[0]).unwrap(), "(and)");
+        // Nothing before the step that touches it guarantees the goal.
+        let sure = remaining(&goal, &steps(), &opaque, Bound::Sufficient)
+            .ok()
+            .unwrap();
+        assert_eq!(show(&sure[1]).unwrap(), "(forall (?x) (q ?x))");
+        assert_eq!(show(&sure[0]), None);
     }
 }
