@@ -1,9 +1,12 @@
-//! Reading input files into [`Sources`], with encoding problems reported as
-//! diagnostics rather than failures.
+//! Reading input files, with encoding problems reported as diagnostics
+//! rather than failures: into [`Sources`] for the PDDL commands, and as the
+//! project loader's disk ([`Disk`]) for rules files and what they name.
 
+use btc_lang::project::report::decode_diagnostic;
+use btc_lang::project::{FileLoader, Loaded, ReadFailure};
 use btc_pddl::diagnostic::{codes, Diagnostic};
-use btc_pddl::source::{decode, DecodeProblem, FileId, Sources, Span};
-use std::path::Path;
+use btc_pddl::source::{decode, DecodeProblem, FileId, Sources};
+use std::path::{Path, PathBuf};
 
 /// A file's text as read from disk, and what was wrong with it.
 struct Read {
@@ -13,7 +16,7 @@ struct Read {
 }
 
 /// Reads and decodes a file. `Err` only when it cannot be read at all.
-fn read(path: &Path) -> anyhow::Result<Read> {
+fn read(path: &Path) -> std::io::Result<Read> {
     let len = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
     if len > btc_pddl::source::MAX_FILE_BYTES as u64 {
         return Ok(Read {
@@ -23,48 +26,54 @@ fn read(path: &Path) -> anyhow::Result<Read> {
             }),
         });
     }
-    let bytes = std::fs::read(path).map_err(|e| {
-        anyhow::anyhow!(
-            "[{}] cannot read `{}`: {e}",
-            codes::FILE_UNREADABLE.id,
-            path.display()
-        )
-    })?;
+    let bytes = std::fs::read(path)?;
     let (text, problem) = decode(&bytes);
     Ok(Read { text, problem })
 }
 
-/// Reads a file into the database (under its normalized path), reporting
-/// encoding problems as diagnostics. `Err` only when it cannot be read.
-pub fn load_into_db(
-    db: &mut btc_lang::db::Database,
-    path: &Path,
-    diags: &mut Vec<Diagnostic>,
-) -> anyhow::Result<btc_lang::db::SourceFile> {
-    let r = read(path)?;
-    let f = db.set_file(&btc_lang::db::normalize(path), r.text);
-    if let Some(p) = r.problem {
-        diags.push(decode_diagnostic(btc_lang::db::file_id(db, f), p));
-    }
-    Ok(f)
+fn unreadable(path: &Path, e: &std::io::Error) -> anyhow::Error {
+    anyhow::anyhow!(
+        "[{}] cannot read `{}`: {e}",
+        codes::FILE_UNREADABLE.id,
+        path.display()
+    )
 }
 
-fn decode_diagnostic(id: FileId, problem: DecodeProblem) -> Diagnostic {
-    match problem {
-        DecodeProblem::InvalidUtf8 { offset, byte } => Diagnostic::error(
-            codes::FILE_ENCODING,
-            Span::new(id, offset, offset + 3),
-            format!("this file is not UTF-8: byte 0x{byte:02X} at offset {offset} is not valid"),
-        )
-        .with_hint("save the file as UTF-8; btc read the rest with the bad bytes replaced"),
-        DecodeProblem::BadUtf16 => Diagnostic::error(
-            codes::FILE_ENCODING,
-            Span::new(id, 0, 0),
-            "this file starts with a UTF-16 byte-order mark but is not valid UTF-16",
-        )
-        .with_hint("save the file as UTF-8"),
-        DecodeProblem::TooLarge { bytes } => too_large(id, bytes as u64),
+/// The disk as the project loader sees it: every file a rules file names
+/// is read through [`read`].
+pub struct Disk;
+
+impl FileLoader for Disk {
+    fn read(&self, path: &Path) -> Result<Loaded, ReadFailure> {
+        match read(path) {
+            Ok(r) => Ok(Loaded {
+                text: r.text,
+                decode: r.problem,
+            }),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Err(ReadFailure::NotFound),
+            Err(e) => Err(ReadFailure::Unreadable {
+                reason: e.to_string(),
+            }),
+        }
     }
+
+    fn list(&self, dir: &Path) -> Vec<PathBuf> {
+        let Ok(entries) = std::fs::read_dir(dir) else {
+            return Vec::new();
+        };
+        let mut out: Vec<PathBuf> = entries
+            .filter_map(Result::ok)
+            .filter(|e| e.file_type().is_ok_and(|t| t.is_file()))
+            .map(|e| dir.join(e.file_name()))
+            .collect();
+        out.sort();
+        out
+    }
+}
+
+/// A file the user named that cannot be read: the command stops (exit 2).
+pub fn unreadable_job_file(e: btc_lang::project::job::Unreadable) -> anyhow::Error {
+    anyhow::anyhow!("[{}] {e}", codes::FILE_UNREADABLE.id)
 }
 
 /// Writes `text` to `path` through a temporary file in the same folder and
@@ -90,21 +99,10 @@ pub fn load(
     path: &Path,
     diags: &mut Vec<Diagnostic>,
 ) -> anyhow::Result<FileId> {
-    let r = read(path)?;
+    let r = read(path).map_err(|e| unreadable(path, &e))?;
     let id = sources.add(path.display().to_string(), r.text);
     if let Some(p) = r.problem {
-        diags.push(decode_diagnostic(id, p));
+        diags.push(decode_diagnostic(id, &p));
     }
     Ok(id)
-}
-
-fn too_large(id: FileId, bytes: u64) -> Diagnostic {
-    Diagnostic::error(
-        codes::FILE_TOO_LARGE,
-        Span::new(id, 0, 0),
-        format!(
-            "this file has {bytes} bytes; btc reads files of at most {} bytes",
-            btc_pddl::source::MAX_FILE_BYTES
-        ),
-    )
 }

@@ -68,7 +68,9 @@ enum Command {
         /// The plan to compile.
         #[arg(long)]
         plan: PathBuf,
-        /// The PDDL problem the plan solves (default: the rules file's `problem`).
+        /// The PDDL problem the plan solves (default: `STEM.pddl` beside the
+        /// plan `STEM.EXT`, else the rules file's `problem`, else
+        /// `problem.pddl` beside the plan or the rules file).
         #[arg(long)]
         problem: Option<PathBuf>,
         /// The PDDL domain (default: the rules file's `domain`).
@@ -86,6 +88,10 @@ enum Command {
         /// py_trees: import leaf behaviours from this Python module.
         #[arg(long)]
         node_module: Option<String>,
+        /// Compile a plan that does not replay on its problem (a step whose
+        /// precondition fails, a goal not reached), with warnings.
+        #[arg(long)]
+        allow_invalid_plan: bool,
         /// How to print diagnostics.
         #[arg(long, value_enum, default_value_t)]
         format: Format,
@@ -230,6 +236,7 @@ fn main() -> ExitCode {
             output,
             inline,
             node_module,
+            allow_invalid_plan,
             format,
         } => rules_cmd::compile(&rules_cmd::CompileArgs {
             rules,
@@ -242,6 +249,7 @@ fn main() -> ExitCode {
                 inline,
                 node_module,
             },
+            allow_invalid_plan,
             format,
         }),
         Command::Fmt { files, check } => rules_cmd::fmt(&files, check),

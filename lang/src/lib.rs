@@ -8,4 +8,6 @@
 
 pub mod db;
 pub mod lower;
+pub mod path;
+pub mod project;
 pub mod rules;

@@ -6,6 +6,7 @@ use crate::syntax::FileSyntax;
 use crate::syntax::Tokens;
 use crate::workspace::Workspace;
 use btc_lang::db::{checked_domain, declarations, import_closure, parsed_rules, SourceFile};
+use btc_lang::path::FilePath;
 use btc_lang::rules::ast::{Item, ItemNode, Rule};
 use btc_lang::rules::check::{matched_actions, Decls};
 use btc_pddl::ast::{Action, Domain};
@@ -31,8 +32,8 @@ pub struct Place {
 }
 
 impl<'a> Analysis<'a> {
-    pub fn new(ws: &'a Workspace, path: &str) -> Option<Analysis<'a>> {
-        if !Workspace::is_rules(path) {
+    pub fn new(ws: &'a Workspace, path: &FilePath) -> Option<Analysis<'a>> {
+        if !path.is_rules() {
             return None;
         }
         let file = ws.file(path)?;
@@ -69,7 +70,7 @@ impl<'a> Analysis<'a> {
     /// file on disk).
     pub fn location(&self, p: &Place) -> Option<Location> {
         let path = p.file.path(&self.ws.db);
-        let uri = Url::from_file_path(path).ok()?;
+        let uri = Url::from_file_path(path.as_path()?).ok()?;
         let text = p.file.text(&self.ws.db);
         Some(Location::new(uri, LineIndex::new(text).range(p.span)))
     }

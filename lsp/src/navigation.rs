@@ -115,7 +115,9 @@ pub fn hover(a: &Analysis, offset: usize) -> Option<Hover> {
             format!(
                 "{}\n\ndeclared in `{}`",
                 code_block("btrules", &decl),
-                short(origin)
+                origin
+                    .file_name()
+                    .map_or_else(|| origin.to_string(), str::to_owned)
             )
         }
         Symbol::Table { name, .. } => {
@@ -196,13 +198,6 @@ pub fn hover(a: &Analysis, offset: usize) -> Option<Hover> {
         }),
         range: Some(a.range(span)),
     })
-}
-
-fn short(path: &str) -> &str {
-    std::path::Path::new(path)
-        .file_name()
-        .and_then(|n| n.to_str())
-        .unwrap_or(path)
 }
 
 /// Where the symbol at `offset` is defined.

@@ -41,7 +41,7 @@ pub fn example(name: &str) -> Example {
     names.sort();
     for p in names {
         let name = p.file_name().unwrap().to_string_lossy().into_owned();
-        let f = db.set_file(&db::normalize(&p), std::fs::read_to_string(&p).unwrap());
+        let f = db.set_file(&p, std::fs::read_to_string(&p).unwrap());
         if name.starts_with("plan.") && plan.is_none() {
             plan = Some(f);
         }
@@ -49,7 +49,7 @@ pub fn example(name: &str) -> Example {
             rules = Some(f);
         }
     }
-    let problem = db.file(&db::normalize(&dir.join("problem.pddl")));
+    let problem = db.file(&dir.join("problem.pddl"));
     let job = CompileJob::new(&db, rules.unwrap(), plan.unwrap(), problem, None);
     let ir = db::compile(&db, job)
         .as_ref()
