@@ -1,11 +1,13 @@
 //! Reading input files, with encoding problems reported as diagnostics
-//! rather than failures: into [`Sources`] for the PDDL commands, and as the
-//! project loader's disk ([`Disk`]) for rules files and what they name.
+//! rather than failures (into [`Sources`] for the PDDL commands, and as the
+//! project loader's disk, [`Disk`], for rules files and what they name),
+//! and writing outputs. Every command's files go through here, and through
+//! `btc_files` underneath: one bounded reader, one writer.
 
 use btc_lang::project::report::decode_diagnostic;
 use btc_lang::project::{FileLoader, Loaded, ReadFailure};
 use btc_pddl::diagnostic::{codes, Diagnostic};
-use btc_pddl::source::{decode, DecodeProblem, FileId, Sources};
+use btc_pddl::source::{decode, DecodeProblem, FileId, Sources, MAX_FILE_BYTES};
 use std::path::{Path, PathBuf};
 
 /// A file's text as read from disk, and what was wrong with it.
@@ -16,27 +18,44 @@ struct Read {
 }
 
 /// Reads and decodes a file. `Err` only when it cannot be read at all.
-fn read(path: &Path) -> std::io::Result<Read> {
-    let len = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
-    if len > btc_pddl::source::MAX_FILE_BYTES as u64 {
-        return Ok(Read {
+fn read(path: &Path) -> Result<Read, btc_files::ReadError> {
+    match btc_files::read(path, MAX_FILE_BYTES) {
+        Ok(bytes) => {
+            let (text, problem) = decode_owned(bytes);
+            Ok(Read { text, problem })
+        }
+        Err(btc_files::ReadError::TooLarge { known, .. }) => Ok(Read {
             text: String::new(),
             problem: Some(DecodeProblem::TooLarge {
-                bytes: len as usize,
+                bytes: known.map_or(MAX_FILE_BYTES + 1, |n| n as usize),
             }),
-        });
+        }),
+        Err(e) => Err(e),
     }
-    let bytes = std::fs::read(path)?;
-    let (text, problem) = decode(&bytes);
-    Ok(Read { text, problem })
 }
 
-fn unreadable(path: &Path, e: &std::io::Error) -> anyhow::Error {
-    anyhow::anyhow!(
-        "[{}] cannot read `{}`: {e}",
-        codes::FILE_UNREADABLE.id,
-        path.display()
-    )
+/// The command stops on a file it was given that cannot be read (exit 2).
+fn unreadable(path: &Path, e: &btc_files::ReadError) -> anyhow::Error {
+    let code = match e {
+        btc_files::ReadError::NotAFile { .. } => codes::FILE_NOT_REGULAR,
+        _ => codes::FILE_UNREADABLE,
+    };
+    anyhow::anyhow!("[{}] cannot read `{}`: {e}", code.id, path.display())
+}
+
+/// [`decode`] without copying a UTF-8 file's bytes.
+fn decode_owned(bytes: Vec<u8>) -> (String, Option<DecodeProblem>) {
+    let plain = !bytes.starts_with(&[0xEF, 0xBB, 0xBF])
+        && !bytes.starts_with(&[0xFF, 0xFE])
+        && !bytes.starts_with(&[0xFE, 0xFF]);
+    if plain {
+        match String::from_utf8(bytes) {
+            Ok(s) => (s, None),
+            Err(e) => decode(e.as_bytes()),
+        }
+    } else {
+        decode(&bytes)
+    }
 }
 
 /// The disk as the project loader sees it: every file a rules file names
@@ -50,47 +69,64 @@ impl FileLoader for Disk {
                 text: r.text,
                 decode: r.problem,
             }),
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Err(ReadFailure::NotFound),
-            Err(e) => Err(ReadFailure::Unreadable {
-                reason: e.to_string(),
-            }),
+            Err(e) => Err(failure(e)),
         }
     }
 
     fn list(&self, dir: &Path) -> Vec<PathBuf> {
-        let Ok(entries) = std::fs::read_dir(dir) else {
-            return Vec::new();
-        };
-        let mut out: Vec<PathBuf> = entries
-            .filter_map(Result::ok)
-            .filter(|e| e.file_type().is_ok_and(|t| t.is_file()))
-            .map(|e| dir.join(e.file_name()))
-            .collect();
-        out.sort();
-        out
+        list(dir)
     }
+}
+
+/// A reader's error as the project loader records it.
+pub fn failure(e: btc_files::ReadError) -> ReadFailure {
+    match e {
+        btc_files::ReadError::Io(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            ReadFailure::NotFound
+        }
+        e @ btc_files::ReadError::NotAFile { .. } => ReadFailure::NotAFile {
+            reason: e.to_string(),
+        },
+        e => ReadFailure::Unreadable {
+            reason: e.to_string(),
+        },
+    }
+}
+
+/// The regular files directly in a folder, sorted.
+pub fn list(dir: &Path) -> Vec<PathBuf> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Vec::new();
+    };
+    let mut out: Vec<PathBuf> = entries
+        .filter_map(Result::ok)
+        .filter(|e| e.file_type().is_ok_and(|t| t.is_file()))
+        .map(|e| dir.join(e.file_name()))
+        .collect();
+    out.sort();
+    out
 }
 
 /// A file the user named that cannot be read: the command stops (exit 2).
 pub fn unreadable_job_file(e: btc_lang::project::job::Unreadable) -> anyhow::Error {
-    anyhow::anyhow!("[{}] {e}", codes::FILE_UNREADABLE.id)
+    let code = match e.why {
+        ReadFailure::NotAFile { .. } => codes::FILE_NOT_REGULAR,
+        _ => codes::FILE_UNREADABLE,
+    };
+    anyhow::anyhow!("[{}] {e}", code.id)
 }
 
-/// Writes `text` to `path` through a temporary file in the same folder and
-/// a rename, so a failed run never leaves a half-written output.
+/// Writes an output file (`-o`, `fmt`): atomically for a regular file,
+/// keeping its mode, owner and links; in place for special files.
 pub fn write_atomically(path: &Path, text: &str) -> anyhow::Result<()> {
-    use std::io::Write;
-    let dir = path
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let mut tmp = tempfile::NamedTempFile::new_in(dir)
-        .map_err(|e| anyhow::anyhow!("cannot write in `{}`: {e}", dir.display()))?;
-    tmp.write_all(text.as_bytes())?;
-    tmp.as_file().sync_all()?;
-    tmp.persist(path)
-        .map_err(|e| anyhow::anyhow!("cannot write `{}`: {}", path.display(), e.error))?;
-    Ok(())
+    btc_files::write(path, text.as_bytes())
+        .map_err(|e| anyhow::anyhow!("cannot write `{}`: {e}", path.display()))
+}
+
+/// Opens an output that is written as it is produced (`--trace`).
+pub fn stream(path: &Path) -> anyhow::Result<btc_files::Stream> {
+    btc_files::Stream::create(path)
+        .map_err(|e| anyhow::anyhow!("cannot write `{}`: {e}", path.display()))
 }
 
 /// Reads a file. `Err` only when it cannot be read at all.
@@ -105,4 +141,22 @@ pub fn load(
         diags.push(decode_diagnostic(id, &p));
     }
     Ok(id)
+}
+
+/// Reads a file into the database through [`Disk`], with its encoding
+/// problems as diagnostics. `Err` only when it cannot be read at all.
+pub fn load_into_db(
+    db: &mut btc_lang::db::Database,
+    path: &Path,
+    diags: &mut Vec<Diagnostic>,
+) -> anyhow::Result<btc_lang::db::SourceFile> {
+    let at = btc_lang::path::FilePath::new(path);
+    let f = btc_lang::project::read_file(db, &Disk, &at)
+        .map_err(|why| unreadable_job_file(btc_lang::project::job::Unreadable { path: at, why }))?;
+    diags.extend(
+        btc_lang::project::report::read_diagnostics(db, f)
+            .iter()
+            .cloned(),
+    );
+    Ok(f)
 }

@@ -7,6 +7,7 @@ mod plan_cmd;
 mod report;
 mod rules_cmd;
 mod run_cmd;
+mod trial_cmd;
 mod validate_cmd;
 
 use clap::{Parser, Subcommand, ValueEnum};
@@ -109,6 +110,9 @@ enum Command {
     /// Run a compiled plan (or a tree file) against the problem's simulated
     /// world; exit 0 only when the tree succeeds and the goal holds.
     Run(run_cmd::RunArgs),
+    /// Run an ARIAC 2023 trial file on a cell: the task manager, a floor
+    /// and a ceiling agent, the agility challenges, the competition's scores.
+    Trial(trial_cmd::TrialArgs),
     /// Check that a plan is valid: every step applicable, the goal reached.
     Validate {
         domain: PathBuf,
@@ -257,6 +261,7 @@ fn main() -> ExitCode {
             .map(|()| ExitCode::SUCCESS)
             .map_err(anyhow::Error::from),
         Command::Run(args) => run_cmd::run(&args),
+        Command::Trial(args) => trial_cmd::run(&args),
         Command::Validate {
             domain,
             problem,

@@ -138,6 +138,9 @@ fn find_domain(problem: &Path, name: &str) -> Option<PathBuf> {
     entries.sort();
     entries.into_iter().find(|p| {
         p.extension().is_some_and(|e| e.eq_ignore_ascii_case("pddl"))
-            && std::fs::read_to_string(p).is_ok_and(|t| matches!(pddl::parse_document(&t, 0).0, Some(Document::Domain(d)) if d.name.name == name))
+            && btc_files::read(p, btc_pddl::source::MAX_FILE_BYTES).is_ok_and(|bytes| {
+                let text = btc_pddl::source::decode(&bytes).0;
+                matches!(pddl::parse_document(&text, 0).0, Some(Document::Domain(d)) if d.name.name == name)
+            })
     })
 }

@@ -11,12 +11,14 @@ fn use_color() -> bool {
 }
 
 /// Prints diagnostics to stderr in text mode; in JSON mode returns them for
-/// the caller's document.
+/// the caller's document. At most `MAX_DIAGNOSTICS_PER_FILE` per file, the
+/// rest counted (F005).
 pub fn diagnostics(
     diags: &[Diagnostic],
     sources: &Sources,
     format: Format,
 ) -> Vec<serde_json::Value> {
+    let diags = &render::capped(diags, btc_pddl::limits::MAX_DIAGNOSTICS_PER_FILE);
     match format {
         Format::Text => {
             eprint!("{}", render::to_terminal(diags, sources, use_color()));

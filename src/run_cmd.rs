@@ -8,6 +8,7 @@ use btc_lang::project::PlanSource;
 use btc_pddl::diagnostic::{has_errors, Diagnostic};
 use btc_pddl::pipeline;
 use btc_pddl::source::{FileId, Sources, Span};
+use btc_pddl::state::World;
 use btc_runtime::{Controller, Engine, Kb, LoadError, Options, Scenario, Summary, TreeDoc};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -157,15 +158,11 @@ fn run_rules(a: &RunArgs, rules: &Path, plan: &Path) -> anyhow::Result<ExitCode>
     }
     let doc = TreeDoc::from_ir(ir);
     let anchor = db::file_id(&database, job.plan(&database));
+    let world = world.world().map_err(anyhow::Error::msg)?;
     execute(
         a,
         &doc,
-        Some(btc_runtime::Kb::new(
-            world.domain,
-            world.dix,
-            world.problem,
-            world.pix,
-        )),
+        Some(Kb::new(&world)),
         &mut sources,
         anchor,
         Some(&problem),
@@ -215,14 +212,23 @@ fn run_tree(a: &RunArgs, tree: &Path) -> anyhow::Result<ExitCode> {
     if has_errors(&diags) {
         return fail(&diags, &sources, a.format);
     }
-    let kb = Kb::new(domain, &du.index, problem, &pu.index);
+    let world =
+        World::of_checked(domain, &du.index, problem, &pu.index).map_err(anyhow::Error::msg)?;
+    let doc = doc.with_actions(domain);
     let how = if a.problem.is_some() {
         "given"
     } else {
         "named by the tree file"
     };
     let shown = format!("{} ({how})", problem_path.display());
-    execute(a, &doc, Some(kb), &mut sources, file, Some(&shown))
+    execute(
+        a,
+        &doc,
+        Some(Kb::new(&world)),
+        &mut sources,
+        file,
+        Some(&shown),
+    )
 }
 
 /// Runs a tree; `problem` is the problem as the summary names it.
@@ -266,7 +272,14 @@ fn execute(
         pb
     });
     let pace = Duration::from_millis(a.tick_ms);
+    // The trace goes out tick by tick: bounded memory, and a killed run
+    // leaves every line so far (SIGINT/SIGTERM flush it).
+    let trace = a.trace.as_deref().map(files::stream).transpose()?;
     let status = engine.run(a.max_ticks, |e| {
+        if let Some(t) = &trace {
+            let mut w: &btc_files::Stream = t;
+            let _ = e.drain_trace(&mut w).and_then(|()| t.flush());
+        }
         if let Some(pb) = &bar {
             pb.set_position(e.steps_done() as u64);
             pb.set_message(format!("tick {}", e.tick));
@@ -279,8 +292,11 @@ fn execute(
         pb.finish_and_clear();
     }
     let commands = engine.take_controller().map(Controller::shutdown);
-    if let Some(path) = &a.trace {
-        files::write_atomically(path, &engine.trace_jsonl())?;
+    if let (Some(t), Some(path)) = (trace, &a.trace) {
+        let mut w: &btc_files::Stream = &t;
+        let _ = engine.drain_trace(&mut w);
+        t.finish()
+            .map_err(|e| anyhow::anyhow!("cannot write `{}`: {e}", path.display()))?;
     }
     let summary = engine.summary(status);
     match a.format {
@@ -394,13 +410,24 @@ fn run_replan(a: &RunArgs, rules: &Path) -> anyhow::Result<ExitCode> {
         max_replans: a.max_replans,
         max_ticks: a.max_ticks,
     };
-    let result = btc_agent::run_loop(
+    let trace = a.trace.as_deref().map(files::stream).transpose()?;
+    let mut sink: Box<dyn std::io::Write> = match &trace {
+        Some(t) => Box::new(t),
+        None => Box::new(std::io::sink()),
+    };
+    let result = btc_agent::run_loop_traced(
         &mut database,
         job,
         a.plan.is_some(),
         scenario.as_ref().map(|(s, _)| s),
         &opts,
+        &mut sink,
     );
+    drop(sink);
+    if let (Some(t), Some(path)) = (trace, &a.trace) {
+        t.finish()
+            .map_err(|e| anyhow::anyhow!("cannot write `{}`: {e}", path.display()))?;
+    }
     let sources = database.sources();
     let summary = match result {
         Ok(s) => s,
@@ -417,9 +444,6 @@ fn run_replan(a: &RunArgs, rules: &Path) -> anyhow::Result<ExitCode> {
             return fail(&[diagnostic(&e, f, &scen_sources)], &scen_sources, a.format);
         }
     };
-    if let Some(path) = &a.trace {
-        files::write_atomically(path, &summary.trace)?;
-    }
     match a.format {
         Format::Json => {
             let mut v = serde_json::to_value(&summary)?;

@@ -24,8 +24,9 @@ const ALLOWED: &[(&str, &[&str])] = &[
             "btc-runtime",
         ],
     ),
-    ("btc-lsp", &["btc-lang", "btc-pddl"]),
+    ("btc-lsp", &["btc-files", "btc-lang", "btc-pddl"]),
     ("btc-testkit", &[]),
+    ("btc-files", &[]),
 ];
 
 /// Crates that may use the salsa database.

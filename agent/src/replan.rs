@@ -12,10 +12,10 @@
 //! the database and renders the result.
 
 use btc_lang::db::{self, CompileJob, Database, JobWorld};
-use btc_pddl::ast::Formula;
 use btc_pddl::diagnostic::{codes, Diagnostic};
+use btc_pddl::logic::{Formula, Name, Terms};
 use btc_pddl::source::Span;
-use btc_pddl::state::State;
+use btc_pddl::state::{State, World};
 use btc_planner::Outcome;
 use btc_runtime::engine::{Engine, FaultRecord, Options, Status};
 use btc_runtime::error::LoadError;
@@ -147,13 +147,13 @@ struct Carry {
     state: Option<State>,
     faults: Option<Vec<FaultRt>>,
     tick: u64,
-    /// Goals faults added (high-priority orders), as texts.
-    extra_goals: Vec<String>,
+    /// Goals faults added (high-priority orders).
+    extra_goals: Vec<Formula>,
     /// Parts in the goal replaced by spares: (part, spare).
-    substitutions: Vec<(String, String)>,
+    substitutions: Vec<(Name, Name)>,
     /// Goals of high-priority orders that preempted a plan, to be reached
     /// before the rest of the goal.
-    priority: Vec<String>,
+    priority: Vec<Formula>,
 }
 
 /// Runs the loop on a compile job whose plan file is `job.plan`: with
@@ -167,22 +167,39 @@ pub fn run_loop(
     scenario: Option<&Scenario>,
     opts: &LoopOptions,
 ) -> Result<LoopSummary, LoopError> {
+    let mut trace = Vec::new();
+    let mut out = run_loop_traced(db, job, given_plan, scenario, opts, &mut trace)?;
+    out.trace = String::from_utf8_lossy(&trace).into_owned();
+    Ok(out)
+}
+
+/// [`run_loop`] with the trace (when `opts.engine.trace` is set) written to
+/// `trace` as it happens, tick by tick, instead of kept in the summary: a
+/// long loop holds bounded memory and a killed one leaves its trace so far.
+/// Write errors are the writer's to keep (`btc_files::Stream` does).
+pub fn run_loop_traced(
+    db: &mut Database,
+    job: CompileJob,
+    given_plan: bool,
+    scenario: Option<&Scenario>,
+    opts: &LoopOptions,
+    trace_out: &mut dyn std::io::Write,
+) -> Result<LoopSummary, LoopError> {
     let t0 = Instant::now();
     let plan_path = job.plan(db).path(db).clone();
-    let goal_span = world(db, job)?
-        .problem
+    let goal_span = world(db, job)?.problem.goal.as_ref().map_or(
+        Span::new(problem_file_id(db, job), 0, 0),
+        btc_pddl::ast::Formula::span,
+    );
+    // The world does not change from plan to plan: only the plan file does.
+    let the_world = world(db, job)?
+        .world()
+        .map_err(|m| LoopError::Tree(LoadError::new(codes::X_KB, m)))?;
+    let base_goal = the_world
+        .model()
         .goal
-        .as_ref()
-        .map_or(Span::new(problem_file_id(db, job), 0, 0), Formula::span);
-    let base_goal = {
-        let text = db::job_problem(db, job)
-            .map(|p| p.text(db).clone())
-            .unwrap_or_default();
-        text.get(goal_span.start as usize..goal_span.end as usize)
-            .filter(|g| !g.trim().is_empty())
-            .unwrap_or("(and)")
-            .to_owned()
-    };
+        .clone()
+        .unwrap_or_else(Formula::truth);
     let mut carry = Carry {
         state: None,
         faults: None,
@@ -195,7 +212,7 @@ pub fn run_loop(
         attempts: Vec::new(),
         replans: Vec::new(),
         faults: Vec::new(),
-        goal: base_goal.clone(),
+        goal: base_goal.to_string(),
         goal_reached: false,
         goal_failure: None,
         ticks: 0,
@@ -208,21 +225,23 @@ pub fn run_loop(
     let trace = opts.engine.trace;
     loop {
         let attempt = out.attempts.len() + 1;
-        out.goal = goal_text(&base_goal, &carry);
+        let whole = goal_of(&base_goal, &carry);
+        out.goal = whole.to_string();
         // This attempt's goal: a priority order's first, then the whole.
         let for_priority = !carry.priority.is_empty();
-        let goal_text = if for_priority {
-            priority_text(&carry)
+        let goal = if for_priority {
+            priority_goal(&carry)
         } else {
-            out.goal.clone()
+            whole
         };
+        let goal_text = goal.to_string();
         // Plan (unless the first plan is given) from the carried state.
         let (plan_text, planning_ms, expanded) = if attempt == 1 && given_plan {
             (None, 0.0, 0)
         } else {
             let w = world(db, job)?;
-            let mut kb = kb_at(&w, &carry);
-            let g = goal_formula(&mut kb, &goal_text)?;
+            let mut kb = kb_at(&the_world, &carry);
+            let g = goal_formula(&mut kb, &goal)?;
             kb.set_goal(g);
             if let (true, _) = kb.goal() {
                 if for_priority {
@@ -241,7 +260,7 @@ pub fn run_loop(
                 w.dix,
                 w.pix,
                 &kb.state,
-                Some(kb.formula_ast(g)),
+                Some(&goal.to_ast(goal_span)),
                 &opts.planner,
             )
             .map_err(LoopError::Compile)?;
@@ -253,7 +272,7 @@ pub fn run_loop(
                     report.search.expanded,
                 ),
                 Outcome::Unsolvable => {
-                    let un = unreachable(&w, &mut kb, &goal_text, g, &carry, opts)?;
+                    let un = unreachable(&w, &kb, &goal, goal_span, &carry, opts)?;
                     let lits: Vec<String> = un.iter().map(|u| format!("`{}`", u.literal)).collect();
                     let by: Vec<String> = un.iter().flat_map(|u| u.faults.clone()).collect();
                     // Faults still in effect (a malfunction that outlasted
@@ -340,7 +359,7 @@ pub fn run_loop(
         let plan: Vec<String> = ir.steps.iter().map(|s| s.display()).collect();
         if trace {
             push_event(
-                &mut out.trace,
+                trace_out,
                 serde_json::json!({
                     "event": "plan", "attempt": attempt, "tick": carry.tick,
                     "source": if plan_text.is_some() { "planned" } else { "given" },
@@ -349,9 +368,8 @@ pub fn run_loop(
             );
         }
         // Run, in the carried world.
-        let w = world(db, job)?;
-        let mut kb = kb_at(&w, &carry);
-        let g = goal_formula(&mut kb, &goal_text)?;
+        let mut kb = kb_at(&the_world, &carry);
+        let g = goal_formula(&mut kb, &goal)?;
         kb.set_goal(g);
         let mut engine =
             Engine::build(&doc, Some(kb), opts.engine.clone()).map_err(LoopError::Tree)?;
@@ -368,6 +386,9 @@ pub fn run_loop(
         let tr = Instant::now();
         // A high-priority order whose goal does not hold preempts the plan.
         let (status, preempted) = engine.run_until(opts.max_ticks, |e| {
+            if trace {
+                let _ = e.drain_trace(trace_out);
+            }
             e.kb.as_ref()
                 .is_some_and(|kb| !kb.unmet_extra_goals().is_empty())
         });
@@ -380,7 +401,7 @@ pub fn run_loop(
         } else {
             engine.wait_for_faults(opts.max_ticks)
         };
-        let preempting: Vec<String> = if preempted {
+        let preempting: Vec<Formula> = if preempted {
             engine
                 .kb
                 .as_ref()
@@ -400,11 +421,11 @@ pub fn run_loop(
             .collect();
         out.faults = engine.fault_outcomes(done);
         if trace {
-            out.trace.push_str(&engine.trace_jsonl());
+            let _ = engine.drain_trace(trace_out);
         }
         let discarded = engine.discarded_parts();
         let kb = engine.kb.as_mut().expect("built with a KB");
-        let mut added = kb.extra_goal_texts();
+        let mut added = kb.extra_goals();
         added.retain(|a| !carry.extra_goals.contains(a));
         carry.extra_goals.extend(added.iter().cloned());
         let (goal_ok, goal_why) = kb.goal();
@@ -478,15 +499,14 @@ pub fn run_loop(
             adjustments.push(format!("a fault added the goal `{a}`"));
         }
         {
-            let w = world(db, job)?;
-            let kb = kb_at(&w, &carry);
+            let kb = kb_at(&the_world, &carry);
+            let named = goal.objects();
             for (part, fault) in discarded {
-                if carry.substitutions.iter().any(|(p, _)| *p == part)
-                    || !mentions(&goal_text, &part)
-                {
+                let part = btc_pddl::logic::name(&part);
+                if carry.substitutions.iter().any(|(p, _)| *p == part) || !named.contains(&part) {
                     continue;
                 }
-                match spare(&w, &kb, &part, &carry, &goal_text) {
+                match spare(&kb, &part, &carry, &named) {
                     Some(s) => {
                         adjustments.push(format!(
                             "`{part}` is gone (fault `{fault}`): the goal uses `{s}` instead"
@@ -509,7 +529,7 @@ pub fn run_loop(
                 tick: carry.tick,
                 why: format!(
                     "a high-priority order preempted the plan at tick {end_tick}: {}",
-                    quoted(&preempting)
+                    quoted(&preempting.iter().map(|g| g.to_string()).collect::<Vec<_>>())
                 ),
                 from_step: None,
                 action: None,
@@ -537,15 +557,15 @@ pub fn run_loop(
             if let Some(o) = v.as_object_mut() {
                 o.insert("event".into(), "replan".into());
             }
-            push_event(&mut out.trace, v);
+            push_event(trace_out, v);
         }
         out.replans.push(rp);
     }
-    out.goal = goal_text(&base_goal, &carry);
+    out.goal = goal_of(&base_goal, &carry).to_string();
     out.elapsed_ms = t0.elapsed().as_secs_f64() * 1e3;
     if trace {
         push_event(
-            &mut out.trace,
+            trace_out,
             serde_json::json!({
                 "event": "goal_check", "tick": out.ticks, "goal": out.goal,
                 "reached": out.goal_reached, "replans": out.replans.len(),
@@ -555,9 +575,8 @@ pub fn run_loop(
     Ok(out)
 }
 
-fn push_event(out: &mut String, v: serde_json::Value) {
-    out.push_str(&v.to_string());
-    out.push('\n');
+fn push_event(out: &mut dyn std::io::Write, v: serde_json::Value) {
+    let _ = writeln!(out, "{v}");
 }
 
 fn plural(n: usize, what: &str) -> String {
@@ -592,157 +611,107 @@ fn world(db: &Database, job: CompileJob) -> Result<JobWorld<'_>, LoopError> {
 }
 
 /// The KB of the problem, in the carried state.
-fn kb_at<'w>(w: &JobWorld<'w>, carry: &Carry) -> Kb<'w> {
-    let mut kb = Kb::new(w.domain, w.dix, w.problem, w.pix);
+fn kb_at<'w>(w: &'w World, carry: &Carry) -> Kb<'w> {
+    let mut kb = Kb::new(w);
     if let Some(s) = &carry.state {
         kb.state = s.clone();
     }
     kb
 }
 
-/// The goal text: the problem's with spares for discarded parts, and the
-/// goals faults added.
-fn goal_text(base: &str, carry: &Carry) -> String {
-    let mut g = base.to_owned();
-    for (p, s) in &carry.substitutions {
-        g = replace_word(&g, p, s);
-    }
+/// The goal: the problem's with spares for discarded parts, and the goals
+/// faults added.
+fn goal_of(base: &Formula, carry: &Carry) -> Formula {
+    let g = base.replace_objects(&carry.substitutions);
     if carry.extra_goals.is_empty() {
-        g
-    } else {
-        format!("(and {g} {})", carry.extra_goals.join(" "))
+        return g;
     }
+    let mut parts = vec![g];
+    parts.extend(
+        carry
+            .extra_goals
+            .iter()
+            .map(|e| e.replace_objects(&carry.substitutions)),
+    );
+    Formula::And(parts)
 }
 
 /// The goals of the priority orders still to do, with spares for
 /// discarded parts.
-fn priority_text(carry: &Carry) -> String {
-    let mut parts: Vec<String> = carry.priority.clone();
-    for (p, s) in &carry.substitutions {
-        for g in &mut parts {
-            *g = replace_word(g, p, s);
-        }
-    }
-    if parts.len() == 1 {
-        parts.remove(0)
-    } else {
-        format!("(and {})", parts.join(" "))
-    }
+fn priority_goal(carry: &Carry) -> Formula {
+    let parts: Vec<Formula> = carry
+        .priority
+        .iter()
+        .map(|g| g.replace_objects(&carry.substitutions))
+        .collect();
+    Formula::conjunction(parts).unwrap_or_else(Formula::truth)
 }
 
-fn goal_formula(kb: &mut Kb<'_>, text: &str) -> Result<u32, LoopError> {
-    kb.formula(text).map_err(|m| {
+fn goal_formula(kb: &mut Kb<'_>, goal: &Formula) -> Result<u32, LoopError> {
+    kb.formula(goal).map_err(|m| {
         LoopError::Tree(LoadError::new(
             codes::X_KB,
-            format!("the adjusted goal `{text}` is not a condition of this problem: {m}"),
+            format!("the adjusted goal `{goal}` is not a condition of this problem: {m}"),
         ))
     })
 }
 
-fn is_word(c: char) -> bool {
-    c.is_alphanumeric() || c == '_' || c == '-'
-}
-
-/// `text` with every whole-word `from` replaced by `to`.
-pub fn replace_word(text: &str, from: &str, to: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    let mut rest = text;
-    while let Some(k) = rest.find(from) {
-        let before = rest[..k].chars().next_back();
-        let after = rest[k + from.len()..].chars().next();
-        out.push_str(&rest[..k]);
-        if before.is_some_and(is_word) || after.is_some_and(is_word) {
-            out.push_str(from);
-        } else {
-            out.push_str(to);
-        }
-        rest = &rest[k + from.len()..];
-    }
-    out.push_str(rest);
-    out
-}
-
-fn mentions(text: &str, word: &str) -> bool {
-    replace_word(text, word, "\u{0}") != text
-}
-
 /// A spare for a discarded part: an object of the same types, named
 /// `PART_...`, that is somewhere in the KB, not itself discarded and not
-/// already in the goal.
-fn spare(w: &JobWorld<'_>, kb: &Kb<'_>, part: &str, carry: &Carry, goal: &str) -> Option<String> {
-    let info = w.pix.objects.get(part)?;
+/// already named by the goal.
+fn spare(kb: &Kb<'_>, part: &Name, carry: &Carry, named: &[Name]) -> Option<Name> {
+    let w = kb.world;
+    let id = w.object_id(part)?;
     let prefix = format!("{part}_");
-    let mut cands: Vec<(&String, u32)> = w
-        .pix
-        .objects
-        .iter()
-        .filter(|(n, o)| n.starts_with(&prefix) && o.types == info.types)
-        .map(|(n, o)| (n, o.id))
+    let mut cands: Vec<(&str, u32)> = (0..w.object_count() as u32)
+        .map(|o| (w.object_name(o), o))
+        .filter(|(n, o)| n.starts_with(&prefix) && w.object_types(*o) == w.object_types(id))
         .collect();
     cands.sort();
     cands
         .into_iter()
-        .find(|(n, id)| {
-            !kb.facts_mentioning(*id).is_empty()
-                && !mentions(goal, n)
-                && !carry.substitutions.iter().any(|(p, s)| p == *n || s == *n)
+        .find(|(n, o)| {
+            !kb.facts_mentioning(*o).is_empty()
+                && !named.iter().any(|x| &**x == *n)
+                && !carry
+                    .substitutions
+                    .iter()
+                    .any(|(p, s)| &**p == *n || &**s == *n)
         })
-        .map(|(n, _)| n.clone())
+        .map(|(n, _)| btc_pddl::logic::name(n))
 }
 
-/// The goal's top-level conjuncts that no plan reaches from the KB's
-/// state, with the faults that name them.
+/// The goal's conjuncts (nested conjunctions split too) that no plan
+/// reaches from the KB's state, with the faults that name them.
 fn unreachable(
     w: &JobWorld<'_>,
-    kb: &mut Kb<'_>,
-    goal_text: &str,
-    g: u32,
+    kb: &Kb<'_>,
+    goal: &Formula,
+    span: Span,
     carry: &Carry,
     opts: &LoopOptions,
 ) -> Result<Vec<Unreachable>, LoopError> {
-    let parts: Vec<String> = match kb.formula_ast(g) {
-        Formula::And { parts, .. } => parts
-            .iter()
-            .filter_map(|p| {
-                let s = p.span();
-                goal_text
-                    .get(s.start as usize..s.end as usize)
-                    .map(str::to_owned)
-            })
-            .collect(),
-        _ => vec![goal_text.to_owned()],
-    };
-    let shown =
-        |lit: &str| btc_runtime::faults::naming(carry.faults.as_deref().unwrap_or(&[]), lit);
+    let mut literals = Vec::new();
+    for part in goal.conjuncts() {
+        literals.extend(part.conjuncts().iter().cloned());
+    }
+    let faults = carry.faults.as_deref().unwrap_or(&[]);
     let mut out = Vec::new();
-    for lit in parts {
-        // A nested `(and ...)` (added goals) is split too.
-        let id = goal_formula(kb, &lit)?;
-        let sub: Vec<String> = match kb.formula_ast(id) {
-            Formula::And { parts, .. } => parts
-                .iter()
-                .filter_map(|p| {
-                    let s = p.span();
-                    lit.get(s.start as usize..s.end as usize).map(str::to_owned)
-                })
-                .collect(),
-            _ => vec![lit.clone()],
-        };
-        for l in sub {
-            let id = goal_formula(kb, &l)?;
-            let r = btc_planner::plan_from(
-                w.domain,
-                w.dix,
-                w.pix,
-                &kb.state,
-                Some(kb.formula_ast(id)),
-                &opts.planner,
-            )
-            .map_err(LoopError::Compile)?;
-            if r.outcome == Outcome::Unsolvable {
-                let faults = shown(&l);
-                out.push(Unreachable { literal: l, faults });
-            }
+    for lit in literals {
+        let r = btc_planner::plan_from(
+            w.domain,
+            w.dix,
+            w.pix,
+            &kb.state,
+            Some(&lit.to_ast(span)),
+            &opts.planner,
+        )
+        .map_err(LoopError::Compile)?;
+        if r.outcome == Outcome::Unsolvable {
+            out.push(Unreachable {
+                literal: lit.to_string(),
+                faults: btc_runtime::faults::naming(faults, &lit),
+            });
         }
     }
     Ok(out)
@@ -751,18 +720,34 @@ fn unreachable(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use btc_pddl::logic::{decode, name};
+
+    fn carry() -> Carry {
+        Carry {
+            state: None,
+            faults: None,
+            tick: 0,
+            extra_goals: Vec::new(),
+            substitutions: Vec::new(),
+            priority: Vec::new(),
+        }
+    }
 
     #[test]
-    fn words_are_replaced_whole() {
+    fn spares_replace_objects_not_words() {
+        let base = decode::formula("(and (on battery_red agv1) (on battery_red_2 tray))").unwrap();
+        let mut c = carry();
+        c.substitutions.push((name("battery_red"), name("b2")));
+        c.extra_goals
+            .push(decode::formula("(on battery_red agv2)").unwrap());
         assert_eq!(
-            replace_word(
-                "(on battery_red agv1) (on battery_red_2 x)",
-                "battery_red",
-                "b2"
-            ),
-            "(on b2 agv1) (on battery_red_2 x)"
+            goal_of(&base, &c).to_string(),
+            "(and (and (on b2 agv1) (on battery_red_2 tray)) (on b2 agv2))"
         );
-        assert!(mentions("(on p1 agv1)", "p1"));
-        assert!(!mentions("(on p10 agv1)", "p1"));
+        assert!(base.objects().contains(&name("battery_red")));
+        assert!(!decode::formula("(on p10 agv1)")
+            .unwrap()
+            .objects()
+            .contains(&name("p1")));
     }
 }

@@ -539,6 +539,11 @@ pub struct JobWorld<'db> {
 }
 
 impl<'db> JobWorld<'db> {
+    /// The world of the job's domain and problem, ready for evaluation.
+    pub fn world(&self) -> Result<btc_pddl::state::World, String> {
+        btc_pddl::state::World::of_checked(self.domain, self.dix, self.problem, self.pix)
+    }
+
     /// `None` when the job has no usable domain or problem.
     pub fn of(db: &'db Database, job: CompileJob) -> Option<JobWorld<'db>> {
         let d = job_domain(db, job)?;

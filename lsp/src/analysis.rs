@@ -22,6 +22,9 @@ pub struct Analysis<'a> {
     pub decls: &'a Decls,
     pub domain: Option<(SourceFile, &'a Domain, &'a DomainIndex)>,
     pub syntax: FileSyntax<'a>,
+    /// Built on first use, once per request: building one per span made
+    /// symbol lists quadratic.
+    lines: std::cell::OnceCell<LineIndex<'a>>,
 }
 
 /// A place in some file of the workspace.
@@ -59,11 +62,12 @@ impl<'a> Analysis<'a> {
                 decls,
                 dix: domain.map(|d| d.2),
             },
+            lines: std::cell::OnceCell::new(),
         })
     }
 
-    pub fn line_index(&self) -> LineIndex<'a> {
-        LineIndex::new(self.text)
+    pub fn line_index(&self) -> &LineIndex<'a> {
+        self.lines.get_or_init(|| LineIndex::new(self.text))
     }
 
     /// An LSP location of a place (`None` for stdlib files, which have no
@@ -71,8 +75,12 @@ impl<'a> Analysis<'a> {
     pub fn location(&self, p: &Place) -> Option<Location> {
         let path = p.file.path(&self.ws.db);
         let uri = Url::from_file_path(path.as_path()?).ok()?;
-        let text = p.file.text(&self.ws.db);
-        Some(Location::new(uri, LineIndex::new(text).range(p.span)))
+        let range = if p.file == self.file {
+            self.line_index().range(p.span)
+        } else {
+            LineIndex::new(p.file.text(&self.ws.db)).range(p.span)
+        };
+        Some(Location::new(uri, range))
     }
 
     pub fn range(&self, span: Span) -> Range {

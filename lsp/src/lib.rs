@@ -18,74 +18,157 @@ pub mod symbols;
 pub mod syntax;
 pub mod workspace;
 
+pub mod transport;
+
+use std::io::Write;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
-use std::task::{Context, Poll};
-use tokio::sync::Notify;
-use tower_lsp::jsonrpc::{Request, Response};
+use tokio::io::AsyncWriteExt;
 use tower_lsp::{LspService, Server};
-use tower_service::Service;
+use transport::{Checked, Framer, Next};
 
-/// Serves LSP on stdin/stdout until the client sends `exit` (or closes
-/// stdin).
-pub async fn serve_stdio() {
-    let (service, socket) = LspService::new(server::Backend::new);
-    let exited = Arc::new(Notify::new());
-    let service = ExitWatch {
-        inner: service,
-        exited: exited.clone(),
-    };
-    // tower-lsp's `serve` returns only when stdin ends; editors keep it
-    // open after `exit`, so stop on `exit` too.
-    tokio::select! {
-        () = Server::new(tokio::io::stdin(), tokio::io::stdout(), socket).serve(service) => {}
-        () = exited.notified() => {}
+/// What the writer thread does next.
+enum Out {
+    /// Bytes as tower-lsp framed them (whole messages: its codec writes
+    /// each frame from one buffer).
+    Raw(Vec<u8>),
+    /// End the process once everything before is written.
+    Exit(i32),
+}
+
+/// tower-lsp's output: every write goes to the writer thread whole.
+struct ToWriter(std::sync::mpsc::Sender<Out>);
+
+impl tokio::io::AsyncWrite for ToWriter {
+    fn poll_write(
+        self: std::pin::Pin<&mut Self>,
+        _: &mut std::task::Context<'_>,
+        buf: &[u8],
+    ) -> std::task::Poll<std::io::Result<usize>> {
+        let _ = self.0.send(Out::Raw(buf.to_vec()));
+        std::task::Poll::Ready(Ok(buf.len()))
+    }
+
+    fn poll_flush(
+        self: std::pin::Pin<&mut Self>,
+        _: &mut std::task::Context<'_>,
+    ) -> std::task::Poll<std::io::Result<()>> {
+        std::task::Poll::Ready(Ok(()))
+    }
+
+    fn poll_shutdown(
+        self: std::pin::Pin<&mut Self>,
+        _: &mut std::task::Context<'_>,
+    ) -> std::task::Poll<std::io::Result<()>> {
+        std::task::Poll::Ready(Ok(()))
     }
 }
 
-/// Passes requests through and tells when `exit` has been handled.
-struct ExitWatch<S> {
-    inner: S,
-    exited: Arc<Notify>,
-}
-
-impl<S> Service<Request> for ExitWatch<S>
-where
-    S: Service<Request, Response = Option<Response>>,
-    S::Future: Send + 'static,
-{
-    type Response = Option<Response>;
-    type Error = S::Error;
-    type Future = std::pin::Pin<
-        Box<dyn std::future::Future<Output = Result<Option<Response>, S::Error>> + Send>,
-    >;
-
-    fn poll_ready(&mut self, cx: &mut Context<'_>) -> Poll<Result<(), S::Error>> {
-        self.inner.poll_ready(cx)
-    }
-
-    fn call(&mut self, req: Request) -> Self::Future {
-        let exit = req.method() == "exit";
-        let fut = self.inner.call(req);
-        let exited = self.exited.clone();
-        Box::pin(async move {
-            let r = fut.await;
-            if exit {
-                exited.notify_one();
-            }
-            r
-        })
-    }
-}
-
-/// [`serve_stdio`] on a runtime of its own (for the `btc lsp` command).
+/// Serves LSP on stdin/stdout (for the `btc lsp` command) until the client
+/// sends `exit` or closes stdin; then the process ends with 0 if
+/// `shutdown` came first, 1 otherwise. Never returns normally.
 pub fn run_stdio() -> std::io::Result<()> {
+    let (out_tx, out_rx) = std::sync::mpsc::channel::<Out>();
+    std::thread::Builder::new()
+        .name("lsp-writer".into())
+        .spawn(move || {
+            let mut stdout = std::io::stdout().lock();
+            for o in out_rx {
+                match o {
+                    Out::Raw(bytes) => {
+                        let _ = stdout.write_all(&bytes).and_then(|()| stdout.flush());
+                    }
+                    Out::Exit(code) => {
+                        let _ = stdout.flush();
+                        std::process::exit(code);
+                    }
+                }
+            }
+        })?;
     let rt = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
+        .thread_stack_size(8 << 20)
         .enable_all()
         .build()?;
-    rt.block_on(serve_stdio());
-    // Tokio reads stdin on a blocking thread that waits for the next line
-    // even after `exit`; do not wait for it.
-    rt.shutdown_background();
+    let (to_server, server_in) = tokio::io::duplex(1 << 20);
+    let (in_tx, mut in_rx) = tokio::sync::mpsc::unbounded_channel::<Vec<u8>>();
+    let shutdown = Arc::new(AtomicBool::new(false));
+    {
+        let out = out_tx.clone();
+        let shutdown = shutdown.clone();
+        std::thread::Builder::new()
+            .name("lsp-reader".into())
+            .spawn(move || read_stdin(&in_tx, &out, &shutdown))?;
+    }
+    rt.block_on(async move {
+        let mut to_server = to_server;
+        tokio::spawn(async move {
+            while let Some(frame) = in_rx.recv().await {
+                if to_server.write_all(&frame).await.is_err() {
+                    break;
+                }
+            }
+        });
+        let (service, socket) = LspService::new(server::Backend::new);
+        Server::new(server_in, ToWriter(out_tx.clone()), socket)
+            .serve(service)
+            .await;
+        let code = if shutdown.load(Ordering::SeqCst) {
+            0
+        } else {
+            1
+        };
+        let _ = out_tx.send(Out::Exit(code));
+        std::future::pending::<()>().await
+    });
     Ok(())
+}
+
+/// The reader thread: frames, checks, forwards; answers what is not a
+/// message; ends the process on `exit` and at the end of stdin.
+fn read_stdin(
+    to_server: &tokio::sync::mpsc::UnboundedSender<Vec<u8>>,
+    out: &std::sync::mpsc::Sender<Out>,
+    shutdown: &AtomicBool,
+) {
+    let reply = |v: serde_json::Value| {
+        let _ = out.send(Out::Raw(transport::frame(v.to_string().as_bytes())));
+    };
+    let mut framer = Framer::new(std::io::stdin().lock());
+    loop {
+        match framer.next_message() {
+            Next::Eof => break,
+            Next::Bad(why) => reply(transport::error(
+                serde_json::Value::Null,
+                transport::PARSE_ERROR,
+                &why,
+            )),
+            Next::Body(body) => match transport::check(&body) {
+                Checked::Reply(v) => reply(v),
+                Checked::Drop => {}
+                Checked::Forward {
+                    method,
+                    body: fixed,
+                } => {
+                    match method.as_deref() {
+                        Some("shutdown") => shutdown.store(true, Ordering::SeqCst),
+                        Some("exit") => break,
+                        _ => {}
+                    }
+                    let body = fixed.unwrap_or(body);
+                    if to_server.send(transport::frame(&body)).is_err() {
+                        break;
+                    }
+                }
+            },
+        }
+    }
+    // `exit`, or the client is gone: whatever is pending (a request of the
+    // server's that was never answered) does not keep the process alive.
+    let code = if shutdown.load(Ordering::SeqCst) {
+        0
+    } else {
+        1
+    };
+    let _ = out.send(Out::Exit(code));
 }

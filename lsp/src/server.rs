@@ -15,6 +15,9 @@ use tower_lsp::{Client, LanguageServer};
 pub struct Backend {
     client: Client,
     ws: Arc<Mutex<Workspace>>,
+    /// Bumped by every edit: diagnostics computed for an older text are
+    /// not worth publishing (a newer edit supersedes them).
+    generation: std::sync::atomic::AtomicU64,
 }
 
 impl Backend {
@@ -22,6 +25,7 @@ impl Backend {
         Backend {
             client,
             ws: Arc::new(Mutex::new(Workspace::new())),
+            generation: std::sync::atomic::AtomicU64::new(0),
         }
     }
 
@@ -31,27 +35,64 @@ impl Backend {
         self.ws.lock().unwrap_or_else(|e| e.into_inner())
     }
 
-    /// Re-checks and publishes diagnostics for every affected file.
+    /// Re-checks and publishes diagnostics for every affected file, unless
+    /// another edit came in meanwhile (it publishes instead).
     async fn publish(&self) {
-        let batches: Vec<(Url, Vec<tower_lsp::lsp_types::Diagnostic>, Option<i32>)> = {
-            let mut ws = self.ws();
-            let all = ws.diagnostics();
-            all.into_iter()
-                .filter_map(|fd| convert_file(&ws, fd))
-                .collect()
-        };
+        use std::sync::atomic::Ordering;
+        let mine = self.generation.fetch_add(1, Ordering::SeqCst) + 1;
+        // Let edits already read in be applied first.
+        tokio::task::yield_now().await;
+        if self.generation.load(Ordering::SeqCst) != mine {
+            return;
+        }
+        let batches: Vec<(Url, Vec<tower_lsp::lsp_types::Diagnostic>, Option<i32>)> =
+            isolated(|| {
+                let mut ws = self.ws();
+                let all = ws.diagnostics();
+                all.into_iter()
+                    .filter_map(|fd| convert_file(&ws, fd))
+                    .collect()
+            })
+            .unwrap_or_default();
+        if self.generation.load(Ordering::SeqCst) != mine {
+            return;
+        }
         for (uri, diags, version) in batches {
             self.client.publish_diagnostics(uri, diags, version).await;
         }
     }
 
     /// Runs `f` on the analysis of the document `uri`, if it is a rules file.
-    fn with_analysis<T>(&self, uri: &Url, f: impl FnOnce(&Analysis) -> Option<T>) -> Option<T> {
-        let path = path_of(uri)?;
-        let ws = self.ws();
-        let a = Analysis::new(&ws, &path)?;
-        f(&a)
+    /// A panic answers this request with an internal error; the server
+    /// keeps serving (the workspace is consistent: inputs are set whole).
+    fn with_analysis<T>(
+        &self,
+        uri: &Url,
+        f: impl FnOnce(&Analysis) -> Option<T>,
+    ) -> Result<Option<T>> {
+        isolated(|| {
+            let path = path_of(uri)?;
+            let ws = self.ws();
+            let a = Analysis::new(&ws, &path)?;
+            f(&a)
+        })
     }
+}
+
+/// Runs a request's work; a panic becomes the request's error response.
+fn isolated<T>(f: impl FnOnce() -> T) -> Result<T> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).map_err(|e| {
+        let what = e
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| e.downcast_ref::<String>().cloned())
+            .unwrap_or_default();
+        Error {
+            code: tower_lsp::jsonrpc::ErrorCode::InternalError,
+            message: format!("btc failed on this request: {what}").into(),
+            data: None,
+        }
+    })
 }
 
 /// The database path of a document URI (an absolute file path).
@@ -67,7 +108,9 @@ fn convert_file(
     let uri = Url::from_file_path(fd.path.as_path()?).ok()?;
     let text = ws.text(&fd.path).unwrap_or_default();
     let ix = LineIndex::new(text);
-    let diags = fd.diagnostics.iter().map(|d| to_lsp(ws, &ix, d)).collect();
+    let capped =
+        btc_pddl::render::capped(&fd.diagnostics, btc_pddl::limits::MAX_DIAGNOSTICS_PER_FILE);
+    let diags = capped.iter().map(|d| to_lsp(ws, &ix, d)).collect();
     Some((uri, diags, fd.version))
 }
 
@@ -226,10 +269,10 @@ impl LanguageServer for Backend {
 
     async fn hover(&self, p: HoverParams) -> Result<Option<Hover>> {
         let pp = p.text_document_position_params;
-        Ok(self.with_analysis(&pp.text_document.uri, |a| {
+        self.with_analysis(&pp.text_document.uri, |a| {
             let off = a.line_index().offset(pp.position);
             navigation::hover(a, off)
-        }))
+        })
     }
 
     async fn goto_definition(
@@ -237,17 +280,17 @@ impl LanguageServer for Backend {
         p: GotoDefinitionParams,
     ) -> Result<Option<GotoDefinitionResponse>> {
         let pp = p.text_document_position_params;
-        Ok(self.with_analysis(&pp.text_document.uri, |a| {
+        self.with_analysis(&pp.text_document.uri, |a| {
             let off = a.line_index().offset(pp.position);
             let place = navigation::definition(a, off)?;
             a.location(&place).map(GotoDefinitionResponse::Scalar)
-        }))
+        })
     }
 
     async fn references(&self, p: ReferenceParams) -> Result<Option<Vec<Location>>> {
         let pp = p.text_document_position;
         let include = p.context.include_declaration;
-        Ok(self.with_analysis(&pp.text_document.uri, |a| {
+        self.with_analysis(&pp.text_document.uri, |a| {
             let off = a.line_index().offset(pp.position);
             let def = navigation::definition(a, off);
             let places = navigation::references(a, off)?;
@@ -258,53 +301,52 @@ impl LanguageServer for Backend {
                     .filter_map(|pl| a.location(pl))
                     .collect(),
             )
-        }))
+        })
     }
 
     async fn document_symbol(
         &self,
         p: DocumentSymbolParams,
     ) -> Result<Option<DocumentSymbolResponse>> {
-        Ok(self.with_analysis(&p.text_document.uri, |a| {
+        self.with_analysis(&p.text_document.uri, |a| {
             Some(DocumentSymbolResponse::Nested(symbols::document_symbols(a)))
-        }))
+        })
     }
 
     async fn symbol(&self, p: WorkspaceSymbolParams) -> Result<Option<Vec<SymbolInformation>>> {
-        let ws = self.ws();
-        Ok(Some(symbols::workspace_symbols(&ws, &p.query)))
+        isolated(|| Some(symbols::workspace_symbols(&self.ws(), &p.query)))
     }
 
     async fn completion(&self, p: CompletionParams) -> Result<Option<CompletionResponse>> {
         let pp = p.text_document_position;
-        Ok(self.with_analysis(&pp.text_document.uri, |a| {
+        self.with_analysis(&pp.text_document.uri, |a| {
             let off = a.line_index().offset(pp.position);
             Some(CompletionResponse::Array(completion::completion(a, off)))
-        }))
+        })
     }
 
     async fn signature_help(&self, p: SignatureHelpParams) -> Result<Option<SignatureHelp>> {
         let pp = p.text_document_position_params;
-        Ok(self.with_analysis(&pp.text_document.uri, |a| {
+        self.with_analysis(&pp.text_document.uri, |a| {
             let off = a.line_index().offset(pp.position);
             completion::signature_help(a, off)
-        }))
+        })
     }
 
     async fn semantic_tokens_full(
         &self,
         p: SemanticTokensParams,
     ) -> Result<Option<SemanticTokensResult>> {
-        Ok(self.with_analysis(&p.text_document.uri, |a| {
+        self.with_analysis(&p.text_document.uri, |a| {
             Some(SemanticTokensResult::Tokens(SemanticTokens {
                 result_id: None,
                 data: highlight::semantic_tokens(a),
             }))
-        }))
+        })
     }
 
     async fn formatting(&self, p: DocumentFormattingParams) -> Result<Option<Vec<TextEdit>>> {
-        Ok(self.with_analysis(&p.text_document.uri, edits::format))
+        self.with_analysis(&p.text_document.uri, edits::format)
     }
 
     async fn rename(&self, p: RenameParams) -> Result<Option<WorkspaceEdit>> {
@@ -313,7 +355,7 @@ impl LanguageServer for Backend {
             let off = a.line_index().offset(pp.position);
             Some(navigation::rename(a, off, &p.new_name))
         });
-        match r {
+        match r? {
             None => Ok(None),
             Some(Ok(edit)) => Ok(Some(edit)),
             Some(Err(e)) => Err(Error::invalid_params(e.0)),
@@ -321,22 +363,22 @@ impl LanguageServer for Backend {
     }
 
     async fn inlay_hint(&self, p: InlayHintParams) -> Result<Option<Vec<InlayHint>>> {
-        Ok(self.with_analysis(&p.text_document.uri, |a| {
+        self.with_analysis(&p.text_document.uri, |a| {
             Some(highlight::inlay_hints(a, p.range))
-        }))
+        })
     }
 
     async fn code_action(&self, p: CodeActionParams) -> Result<Option<CodeActionResponse>> {
         let uri = p.text_document.uri.clone();
-        Ok(self.with_analysis(&p.text_document.uri, |a| {
+        self.with_analysis(&p.text_document.uri, |a| {
             let ix = a.line_index();
-            let conv = |d: &Diagnostic| to_lsp(a.ws, &ix, d);
+            let conv = |d: &Diagnostic| to_lsp(a.ws, ix, d);
             Some(
                 edits::code_actions(a, &uri, p.range, &conv)
                     .into_iter()
                     .map(CodeActionOrCommand::CodeAction)
                     .collect(),
             )
-        }))
+        })
     }
 }

@@ -15,30 +15,27 @@ use tower_lsp::lsp_types::TextDocumentContentChangeEvent;
 
 /// Files larger than this are not read from disk (the CLI's limit is 1 GiB;
 /// an editor has no use for more than this).
-const MAX_DISK_FILE: u64 = 64 << 20;
+const MAX_DISK_FILE: usize = 64 << 20;
 
-/// The disk as the language server reads it (open documents come from the
-/// editor instead).
+/// The disk as the language server reads it, through the CLI's bounded
+/// reader (devices and folders are refused, nothing is read past the
+/// limit). Open documents come from the editor instead.
 pub struct Disk;
 
 impl FileLoader for Disk {
     fn read(&self, path: &Path) -> Result<Loaded, ReadFailure> {
-        let meta = std::fs::metadata(path).map_err(|e| failure(&e))?;
-        if !meta.is_file() {
-            return Err(ReadFailure::Unreadable {
-                reason: "not a regular file".into(),
-            });
+        match btc_files::read(path, MAX_DISK_FILE) {
+            Ok(bytes) => Ok(Loaded::from_bytes(&bytes)),
+            Err(btc_files::ReadError::Io(e)) if e.kind() == std::io::ErrorKind::NotFound => {
+                Err(ReadFailure::NotFound)
+            }
+            Err(e @ btc_files::ReadError::NotAFile { .. }) => Err(ReadFailure::NotAFile {
+                reason: e.to_string(),
+            }),
+            Err(e) => Err(ReadFailure::Unreadable {
+                reason: e.to_string(),
+            }),
         }
-        if meta.len() > MAX_DISK_FILE {
-            return Err(ReadFailure::Unreadable {
-                reason: format!(
-                    "{} bytes; the language server reads files of at most {MAX_DISK_FILE} bytes",
-                    meta.len()
-                ),
-            });
-        }
-        let bytes = std::fs::read(path).map_err(|e| failure(&e))?;
-        Ok(Loaded::from_bytes(&bytes))
     }
 
     fn list(&self, dir: &Path) -> Vec<PathBuf> {
@@ -54,15 +51,6 @@ impl FileLoader for Disk {
     }
 }
 
-fn failure(e: &std::io::Error) -> ReadFailure {
-    match e.kind() {
-        std::io::ErrorKind::NotFound => ReadFailure::NotFound,
-        _ => ReadFailure::Unreadable {
-            reason: e.to_string(),
-        },
-    }
-}
-
 pub struct Workspace {
     pub db: Database,
     /// Open documents: path to the editor's version.
@@ -70,8 +58,15 @@ pub struct Workspace {
     /// Paths that had diagnostics at the last publication: they get an empty
     /// list when their problems are gone.
     published: BTreeSet<FilePath>,
+    /// Open documents over [`MAX_ANALYSED`]: their text (edits still apply)
+    /// while the database holds them empty.
+    oversize: BTreeMap<FilePath, String>,
     loader: Box<dyn FileLoader + Send>,
 }
+
+/// The largest document the server analyses; a larger one gets one
+/// diagnostic (F006) saying so, and is otherwise left alone.
+pub const MAX_ANALYSED: usize = 16 << 20;
 
 /// One file's diagnostics, ready to publish.
 pub struct FileDiagnostics {
@@ -98,6 +93,7 @@ impl Workspace {
             db: Database::new(),
             open: BTreeMap::new(),
             published: BTreeSet::new(),
+            oversize: BTreeMap::new(),
             loader,
         }
     }
@@ -107,7 +103,21 @@ impl Workspace {
     }
 
     pub fn text(&self, path: &FilePath) -> Option<&str> {
+        if let Some(t) = self.oversize.get(path) {
+            return Some(t);
+        }
         self.db.file(path).map(|f| f.text(&self.db).as_str())
+    }
+
+    /// An editor's text into the database, unless it is too large to analyse.
+    fn set_document(&mut self, path: &FilePath, text: String) -> SourceFile {
+        if text.len() > MAX_ANALYSED {
+            self.oversize.insert(path.clone(), text);
+            self.db.set_file(path, String::new())
+        } else {
+            self.oversize.remove(path);
+            self.db.set_file(path, text)
+        }
     }
 
     pub fn is_open(&self, path: &FilePath) -> bool {
@@ -116,7 +126,7 @@ impl Workspace {
 
     pub fn open(&mut self, path: &FilePath, text: String, version: i32) {
         self.open.insert(path.clone(), version);
-        let f = self.db.set_file(path, text);
+        let f = self.set_document(path, text);
         project::load_references(&mut self.db, self.loader.as_ref(), f);
     }
 
@@ -146,6 +156,7 @@ impl Workspace {
     /// The editor closed a document: what is on disk counts again.
     pub fn close(&mut self, path: &FilePath) {
         self.open.remove(path);
+        self.oversize.remove(path);
         self.reload_from_disk(path);
     }
 
@@ -242,6 +253,19 @@ impl Workspace {
                 );
                 list.extend(cd.diagnostics.iter().cloned());
             }
+        }
+        for (p, t) in &self.oversize {
+            let Some(f) = self.db.file(p) else { continue };
+            let id = file_id(&self.db, f);
+            // Only this: the (empty) text the database holds says nothing.
+            by_path.insert(p.clone(), vec![Diagnostic::error(
+                btc_pddl::diagnostic::codes::DOCUMENT_TOO_LARGE,
+                btc_pddl::source::Span::new(id, 0, 0),
+                format!(
+                    "this document has {} bytes; the language server analyses documents of at most {MAX_ANALYSED} bytes",
+                    t.len()
+                ),
+            ).with_hint("`btc check` reads files up to 1 GiB")]);
         }
         let now: BTreeSet<FilePath> = by_path
             .iter()

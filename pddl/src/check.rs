@@ -916,29 +916,55 @@ fn stratify(domain: &Domain, index: &DomainIndex, diags: &mut Vec<Diagnostic>) -
     if n == 0 {
         return Vec::new();
     }
-    let pos_of = |name: &str| domain.derived.iter().position(|d| d.head.name.name == name);
-    // edges[i]: (j, negative) — rule i's body mentions derived predicate j.
-    let edges: Vec<Vec<(usize, bool)>> = domain
+    // uses[i]: (j, negative) — rule i's body mentions the predicate rule j derives.
+    let uses: Vec<Vec<(usize, bool)>> = domain
         .derived
         .iter()
         .map(|d| {
             let mut out = Vec::new();
             collect_derived_uses(&d.body, true, &mut |name, positive| {
                 if index.derived.contains(name) {
-                    if let Some(j) = pos_of(name) {
-                        out.push((j, !positive));
+                    for (j, other) in domain.derived.iter().enumerate() {
+                        if other.head.name.name == name {
+                            out.push((j, !positive));
+                        }
                     }
                 }
             });
             out
         })
         .collect();
+    match strata_of(&uses) {
+        Some(strata) => strata,
+        None => {
+            let d = &domain.derived[0];
+            diags.push(
+                Diagnostic::error(
+                    codes::NOT_STRATIFIED,
+                    d.head.name.span,
+                    "derived predicates depend on their own negation",
+                )
+                .with_hint(
+                    "rewrite the `:derived` rules so no predicate depends on its own negation",
+                ),
+            );
+            vec![(0..n).collect()]
+        }
+    }
+}
+
+/// Strata of derived rules from what each rule's body uses (`uses[i]`:
+/// rules `j` it depends on, and whether through a negation): a rule comes
+/// no earlier than what it uses, and after what it negates. `None` when a
+/// rule depends on its own negation.
+pub fn strata_of(uses: &[Vec<(usize, bool)>]) -> Option<Vec<Vec<usize>>> {
+    let n = uses.len();
     let mut level = vec![0usize; n];
     // Bellman-Ford style relaxation; a level above n means a negative cycle.
     for _ in 0..=n {
         let mut changed = false;
         for i in 0..n {
-            for &(j, neg) in &edges[i] {
+            for &(j, neg) in &uses[i] {
                 let need = level[j] + usize::from(neg);
                 if level[i] < need {
                     level[i] = need;
@@ -950,24 +976,17 @@ fn stratify(domain: &Domain, index: &DomainIndex, diags: &mut Vec<Diagnostic>) -
             break;
         }
     }
-    if level.iter().any(|&l| l > n) || has_negative_cycle(&edges, n) {
-        let d = &domain.derived[0];
-        diags.push(
-            Diagnostic::error(
-                codes::NOT_STRATIFIED,
-                d.head.name.span,
-                "derived predicates depend on their own negation",
-            )
-            .with_hint("rewrite the `:derived` rules so no predicate depends on its own negation"),
-        );
-        return vec![(0..n).collect()];
+    if level.iter().any(|&l| l > n) || has_negative_cycle(uses, n) {
+        return None;
     }
     let max = level.iter().copied().max().unwrap_or(0);
     // Several rules may derive the same predicate: they share a level.
-    (0..=max)
-        .map(|l| (0..n).filter(|&i| level[i] == l).collect())
-        .filter(|v: &Vec<usize>| !v.is_empty())
-        .collect()
+    Some(
+        (0..=max)
+            .map(|l| (0..n).filter(|&i| level[i] == l).collect())
+            .filter(|v: &Vec<usize>| !v.is_empty())
+            .collect(),
+    )
 }
 
 fn has_negative_cycle(edges: &[Vec<(usize, bool)>], n: usize) -> bool {

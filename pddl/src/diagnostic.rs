@@ -121,15 +121,90 @@ impl Diagnostic {
     }
 }
 
+/// Keeps the first [`MAX_DIAGNOSTICS_PER_FILE`](crate::limits::MAX_DIAGNOSTICS_PER_FILE)
+/// diagnostics of one kind that a pass makes, and counts the rest into one
+/// closing diagnostic: a file of a million bad characters costs a hundred
+/// diagnostics, not a million.
+pub struct Cap {
+    seen: usize,
+    code: Code,
+    what: &'static str,
+}
+
+impl Cap {
+    /// `what` names the kind in the summary ("lexical error").
+    pub fn new(code: Code, what: &'static str) -> Cap {
+        Cap {
+            seen: 0,
+            code,
+            what,
+        }
+    }
+
+    pub fn push(&mut self, out: &mut Vec<Diagnostic>, d: Diagnostic) {
+        self.seen += 1;
+        if self.seen <= crate::limits::MAX_DIAGNOSTICS_PER_FILE {
+            out.push(d);
+        }
+    }
+
+    /// Whether a diagnostic pushed now would be kept (so that its message
+    /// need not be built otherwise).
+    pub fn full(&self) -> bool {
+        self.seen >= crate::limits::MAX_DIAGNOSTICS_PER_FILE
+    }
+
+    /// Counts one more without building it (see [`Cap::full`]).
+    pub fn skip(&mut self) {
+        self.seen += 1;
+    }
+
+    pub fn finish(self, out: &mut Vec<Diagnostic>, at: Span) {
+        let max = crate::limits::MAX_DIAGNOSTICS_PER_FILE;
+        if let Some(more) = self.seen.checked_sub(max).filter(|n| *n > 0) {
+            out.push(Diagnostic::error(
+                self.code,
+                at,
+                format!(
+                    "and {more} more {}{} in this file, not shown",
+                    self.what,
+                    if more == 1 { "" } else { "s" }
+                ),
+            ));
+        }
+    }
+}
+
+/// A user's word as a message shows it: cut to 60 characters, so that a
+/// 10 MB name makes a short message.
+pub fn shown(word: &str) -> std::borrow::Cow<'_, str> {
+    const MAX: usize = 60;
+    match word.char_indices().nth(MAX) {
+        Some((cut, _)) => format!("{}…", &word[..cut]).into(),
+        None => word.into(),
+    }
+}
+
 pub fn has_errors(diags: &[Diagnostic]) -> bool {
     diags.iter().any(Diagnostic::is_error)
 }
 
 /// "did you mean" support: the closest candidate within a small edit distance.
+/// Names longer than [`MAX_SUGGESTION_NAME`](crate::limits::MAX_SUGGESTION_NAME)
+/// get no suggestion, and candidates whose length is too far from the
+/// name's are skipped unmeasured: the distance is quadratic in the lengths.
 pub fn closest<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
-    let limit = name.chars().count().div_ceil(3).max(1);
+    let max = crate::limits::MAX_SUGGESTION_NAME;
+    let len = name.chars().count();
+    if len > max {
+        return None;
+    }
+    let limit = len.div_ceil(3).max(1);
     candidates
         .into_iter()
+        // A difference in length is a lower bound of the distance (and a
+        // char has at most 4 bytes, so long candidates go unmeasured).
+        .filter(|c| c.len() <= 4 * max && c.chars().count().abs_diff(len) <= limit)
         .map(|c| (edit_distance(name, c), c))
         .filter(|(d, _)| *d <= limit)
         .min_by_key(|(d, c)| (*d, *c))
@@ -176,6 +251,9 @@ pub mod codes {
         FILE_UNREADABLE = "F001", "a file cannot be read";
         FILE_ENCODING = "F002", "a file is not UTF-8 text";
         FILE_TOO_LARGE = "F003", "a file is larger than btc reads";
+        FILE_NOT_REGULAR = "F004", "a path that is a folder or a device, not a file";
+        MORE_DIAGNOSTICS = "F005", "more diagnostics in one file than btc shows";
+        DOCUMENT_TOO_LARGE = "F006", "a document larger than the language server analyses";
         // PDDL syntax
         INVALID_TOKEN = "P001", "a character or word that PDDL does not allow";
         UNCLOSED_PAREN = "P002", "a `(` is never closed";
@@ -243,6 +321,7 @@ pub mod codes {
         R_UNKNOWN_TYPE = "R021", "a port type that is neither a PDDL type nor a basic type";
         R_PLAN_BLOCK = "R022", "a `plan` block that is missing, repeated or has no `steps`";
         R_BAD_ARGUMENT = "R023", "a control or decorator argument that makes no sense";
+        R_TOO_DEEP = "R060", "a template nested deeper than btc supports";
         // Running trees (btc run)
         X_TREE_SYNTAX = "X001", "a behavior tree file that is not BT.CPP v4 XML or btc's JSON IR";
         X_UNKNOWN_NODE = "X002", "a tree node that is neither built in nor declared";
@@ -253,5 +332,17 @@ pub mod codes {
         X_TOO_DEEP = "X007", "a tree nested deeper than the runtime runs";
         X_REPLAN_UNSOLVABLE = "X008", "a goal that replanning cannot reach after a fault";
         X_REPLAN_LIMIT = "X009", "a closed loop that stopped at its replan or tick limit";
+        // ARIAC trials (btc trial)
+        TRIAL_SYNTAX = "T001", "a trial file that is not YAML btc reads";
+        TRIAL_MISSING = "T002", "a trial field the ARIAC 2023 format requires is missing";
+        TRIAL_VALUE = "T003", "a trial value of the wrong kind or out of range";
+        TRIAL_UNKNOWN_FIELD = "T004", "a trial field the ARIAC 2023 format does not have";
+        TRIAL_NOT_SIMULATED = "T005", "a trial field btc reads but its symbolic world does not simulate";
+        TRIAL_DUPLICATE = "T006", "something given twice in a trial (an order id, a slot, a quadrant)";
+        TRIAL_UNKNOWN_ORDER = "T007", "a condition or challenge naming an order the trial does not have";
+        TRIAL_RULE = "T008", "a trial that breaks an ARIAC 2023 rule";
+        TRIAL_SUPPLY = "T009", "an order the trial's parts cannot fulfil (insufficient parts)";
+        CELL_INVALID = "T010", "a cell file that is not valid";
+        CELL_MAPPING = "T011", "a cell mapping that does not fit the cell's PDDL domain";
     }
 }

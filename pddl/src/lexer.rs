@@ -109,14 +109,18 @@ pub fn lex(text: &str, file: FileId) -> (Vec<Token>, Vec<Diagnostic>) {
             )
         })
         .collect();
+    let mut cap = crate::diagnostic::Cap::new(codes::INVALID_TOKEN, "word that is not PDDL");
     let tokens: Vec<Token> = words
         .unwrap_or_default()
         .into_iter()
         .map(|(word, s)| {
             let span = Span::new(file, s.start, s.end);
             let tok = classify(word);
-            if let Tok::Invalid(w) = &tok {
-                let bad = w
+            if matches!(tok, Tok::Invalid(_)) && cap.full() {
+                cap.skip();
+            } else if let Tok::Invalid(word) = &tok {
+                let w = crate::diagnostic::shown(word);
+                let bad = word
                     .trim_start_matches(['?', ':'])
                     .chars()
                     .find(|c| !is_name_char(*c));
@@ -124,7 +128,8 @@ pub fn lex(text: &str, file: FileId) -> (Vec<Token>, Vec<Diagnostic>) {
                     Some(c) => format!("`{w}` is not a PDDL name: `{c}` is not allowed in names"),
                     None => format!("`{w}` is not a PDDL name"),
                 };
-                diags.push(
+                cap.push(
+                    &mut diags,
                     Diagnostic::error(codes::INVALID_TOKEN, span, message).with_hint(
                         "names are letters, digits, `-` and `_`; variables start with `?`, keywords with `:`",
                     ),
@@ -133,6 +138,7 @@ pub fn lex(text: &str, file: FileId) -> (Vec<Token>, Vec<Diagnostic>) {
             Token { tok, span }
         })
         .collect();
+    cap.finish(&mut diags, Span::new(file, text.len(), text.len()));
     (tokens, diags)
 }
 

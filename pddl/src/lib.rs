@@ -12,6 +12,8 @@ pub mod ast;
 pub mod check;
 pub mod diagnostic;
 pub mod lexer;
+pub mod limits;
+pub mod logic;
 pub mod parse;
 pub mod pipeline;
 pub mod plan;
@@ -22,6 +24,7 @@ pub mod source;
 pub mod state;
 pub mod types;
 pub mod validate;
+pub mod world;
 
 pub use ast::{Domain, Problem};
 pub use check::{check_domain, check_problem, DomainIndex, ProblemIndex};

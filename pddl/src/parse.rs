@@ -1207,3 +1207,17 @@ pub fn effect_of(s: &Sexp) -> (Option<Effect>, Vec<Diagnostic>) {
     let e = p.effect(s);
     (e, p.diags)
 }
+
+/// Reads a predicate or function declaration `(name ?x - t ...)`.
+pub fn predicate_decl_of(s: &Sexp) -> (Option<PredicateDecl>, Vec<Diagnostic>) {
+    let mut p = Parser { diags: Vec::new() };
+    let d = p.predicate_decl(s);
+    (d, p.diags)
+}
+
+/// Reads a fact of `:init`: `(on a b)` or `(= (f a) 3)`.
+pub fn init_fact_of(s: &Sexp) -> (Option<InitFact>, Vec<Diagnostic>) {
+    let mut p = Parser { diags: Vec::new() };
+    let f = p.init_fact(s);
+    (f, p.diags)
+}

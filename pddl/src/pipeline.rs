@@ -118,11 +118,8 @@ pub fn validate_units(
     {
         return None;
     }
-    let world = World::new(domain.domain.as_ref()?, &domain.index, &problem.index);
-    Some(validate(
-        &world,
-        problem.problem.as_ref()?,
-        &plan.plan,
-        &plan.steps,
-    ))
+    let (d, p) = (domain.domain.as_ref()?, problem.problem.as_ref()?);
+    // A checked, error-free domain and problem always make a world.
+    let world = World::of_checked(d, &domain.index, p, &problem.index).ok()?;
+    Some(validate(&world, d, p, &plan.plan, &plan.steps))
 }

@@ -6,7 +6,43 @@ use crate::source::{FileId, Sources, Span};
 use ariadne::{Color, Config, IndexType, Label, Report, ReportKind};
 use serde::Serialize;
 
-/// Renders diagnostics as ariadne reports into a string.
+/// At most `max` diagnostics per file, in order, each file's rest counted
+/// into one closing diagnostic (F005) that says how many more there were:
+/// output and rendering time stay proportional to what anyone reads.
+pub fn capped(diags: &[Diagnostic], max: usize) -> Vec<Diagnostic> {
+    let mut kept: std::collections::BTreeMap<FileId, usize> = Default::default();
+    let mut dropped: std::collections::BTreeMap<FileId, (usize, bool)> = Default::default();
+    let mut out = Vec::new();
+    for d in diags {
+        let n = kept.entry(d.span.file).or_default();
+        if *n < max {
+            *n += 1;
+            out.push(d.clone());
+        } else {
+            let e = dropped.entry(d.span.file).or_default();
+            e.0 += 1;
+            e.1 |= d.is_error();
+        }
+    }
+    for (file, (n, error)) in dropped {
+        let message = format!(
+            "and {n} more diagnostic{} in this file, not shown (btc shows {max} per file)",
+            if n == 1 { "" } else { "s" }
+        );
+        let span = Span::new(file, 0, 0);
+        out.push(if error {
+            Diagnostic::error(crate::diagnostic::codes::MORE_DIAGNOSTICS, span, message)
+        } else {
+            Diagnostic::warning(crate::diagnostic::codes::MORE_DIAGNOSTICS, span, message)
+        });
+    }
+    out
+}
+
+/// Renders diagnostics as ariadne reports into a string. A diagnostic on a
+/// line longer than [`MAX_RENDERED_LINE`](crate::limits::MAX_RENDERED_LINE)
+/// is shown with an excerpt of its line instead (ariadne prints whole
+/// lines, and one 10 MB line per diagnostic is quadratic output).
 pub fn to_terminal(diags: &[Diagnostic], sources: &Sources, color: bool) -> String {
     // One cache for all reports: building ariadne's line index copies the
     // file, so doing it per diagnostic would be quadratic.
@@ -23,9 +59,95 @@ pub fn to_terminal(diags: &[Diagnostic], sources: &Sources, color: bool) -> Stri
     );
     let mut out = Vec::new();
     for d in diags {
-        write_report(d, sources, color, &mut cache, &mut out);
+        if touches_long_line(d, sources) {
+            write_excerpt(d, sources, &mut out);
+        } else {
+            write_report(d, sources, color, &mut cache, &mut out);
+        }
     }
     String::from_utf8_lossy(&out).into_owned()
+}
+
+/// The byte range of the line around `offset`, found by looking at most
+/// a little past the rendering limit each way.
+fn line_around(text: &str, offset: usize) -> (usize, usize, bool) {
+    let max = crate::limits::MAX_RENDERED_LINE;
+    let b = text.as_bytes();
+    let offset = offset.min(b.len());
+    let from = offset.saturating_sub(max + 1);
+    let start = b[from..offset]
+        .iter()
+        .rposition(|&c| c == b'\n')
+        .map(|k| from + k + 1);
+    let to = (offset + max + 1).min(b.len());
+    let end = b[offset..to]
+        .iter()
+        .position(|&c| c == b'\n')
+        .map(|k| offset + k);
+    let long = start.is_none() && from > 0 || end.is_none() && to < b.len();
+    let long = long || end.unwrap_or(to) - start.unwrap_or(from) > max;
+    (start.unwrap_or(from), end.unwrap_or(to), long)
+}
+
+fn touches_long_line(d: &Diagnostic, sources: &Sources) -> bool {
+    std::iter::once(d.span)
+        .chain(d.labels.iter().map(|l| l.span))
+        .any(|s| {
+            let text = sources.text(s.file);
+            line_around(text, s.start as usize).2 || line_around(text, s.end as usize).2
+        })
+}
+
+/// A plain report with an excerpt of a long line around the span.
+fn write_excerpt(d: &Diagnostic, sources: &Sources, out: &mut Vec<u8>) {
+    use std::io::Write;
+    let kind = match d.severity {
+        Severity::Error => "Error",
+        Severity::Warning => "Warning",
+    };
+    let file = sources.get(d.span.file);
+    let (line, col) = file.line_col(d.span.start);
+    let _ = writeln!(out, "[{}] {kind}: {}", d.code, d.message);
+    let _ = writeln!(out, "   ╭─[ {}:{line}:{col} ]", file.path);
+    let text = &file.text;
+    let at = (d.span.start as usize).min(text.len());
+    let half = crate::limits::MAX_RENDERED_LINE / 2;
+    let mut a = at.saturating_sub(half);
+    while !text.is_char_boundary(a) {
+        a -= 1;
+    }
+    let mut b = (at + half).min(text.len());
+    while !text.is_char_boundary(b) {
+        b += 1;
+    }
+    let piece = &text[a..b];
+    let rel = at - a;
+    let from = piece[..rel].rfind('\n').map_or(0, |k| k + 1);
+    let to = piece[rel..].find('\n').map_or(piece.len(), |k| rel + k);
+    let piece = &piece[from..to];
+    let clean = |s: &str| -> String {
+        s.chars()
+            .map(|c| if c.is_control() { '\u{FFFD}' } else { c })
+            .collect()
+    };
+    let before = clean(&piece[..rel - from]);
+    let shown = clean(piece);
+    let _ = writeln!(
+        out,
+        "   │ (line {line} is too long to show whole; around column {col}:)"
+    );
+    let _ = writeln!(out, "   │ …{shown}…");
+    let pad = " ".repeat(before.chars().count() + 1);
+    let _ = writeln!(out, "   │ {pad}^ {}", code_title(d.code));
+    for l in &d.labels {
+        let lf = sources.get(l.span.file);
+        let (ll, lc) = lf.line_col(l.span.start);
+        let _ = writeln!(out, "   │ {}:{ll}:{lc}: {}", lf.path, l.message);
+    }
+    if let Some(h) = &d.hint {
+        let _ = writeln!(out, "   │ Help: {h}");
+    }
+    let _ = writeln!(out, "───╯");
 }
 
 fn ariadne_span(sources: &Sources, span: Span) -> (String, std::ops::Range<usize>) {

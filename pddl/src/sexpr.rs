@@ -8,7 +8,7 @@ use crate::diagnostic::{codes, Diagnostic};
 use crate::source::Span;
 
 /// Deepest nesting of parentheses btc accepts. Real PDDL stays below 30.
-pub const MAX_DEPTH: usize = 200;
+pub const MAX_DEPTH: usize = crate::limits::MAX_NESTING;
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum Sexp {

@@ -114,8 +114,7 @@ impl Sources {
     }
 }
 
-/// Largest file btc reads. Spans are `u32`, and nothing real comes close.
-pub const MAX_FILE_BYTES: usize = 1 << 30;
+pub use crate::limits::MAX_FILE_BYTES;
 
 /// What went wrong while turning bytes into text.
 #[derive(Clone, Debug, PartialEq, Eq)]

@@ -14,6 +14,8 @@ pub const OBJECT: TypeId = 0;
 pub struct TypeTable {
     names: Vec<String>,
     ids: FxHashMap<String, TypeId>,
+    /// Every type's declared parents (none: `object`).
+    parents: Vec<Vec<TypeId>>,
     /// Every type's ancestors, itself and `object` included, sorted.
     ancestors: Vec<Vec<TypeId>>,
 }
@@ -61,22 +63,11 @@ impl TypeTable {
                 }
             }
         }
-        t.ancestors = (0..n as TypeId)
-            .map(|id| {
-                let mut seen = vec![false; n];
-                let mut stack = vec![id];
-                while let Some(x) = stack.pop() {
-                    if !std::mem::replace(&mut seen[x as usize], true) {
-                        stack.extend(&parents[x as usize]);
-                    }
-                }
-                seen[OBJECT as usize] = true;
-                (0..n as TypeId).filter(|&i| seen[i as usize]).collect()
-            })
-            .collect();
+        t.parents = parents;
+        t.close();
         for decl in &domain.types {
             let id = t.ids[decl.name.as_str()];
-            let cyclic = parents[id as usize]
+            let cyclic = t.parents[id as usize]
                 .iter()
                 .any(|&p| t.ancestors[p as usize].binary_search(&id).is_ok());
             if cyclic && first.get(decl.name.as_str()).map(|n| n.span) == Some(decl.name.span) {
@@ -93,6 +84,56 @@ impl TypeTable {
         t
     }
 
+    /// A table from type names and their parents' names (`object` is
+    /// implied); names of unknown parents are returned as errors.
+    pub fn from_parents<'a>(
+        types: impl IntoIterator<Item = (&'a str, Vec<&'a str>)>,
+    ) -> Result<TypeTable, String> {
+        let mut t = TypeTable::default();
+        t.intern("object");
+        let types: Vec<(&str, Vec<&str>)> = types.into_iter().collect();
+        for (name, _) in &types {
+            t.intern(name);
+        }
+        let mut parents: Vec<Vec<TypeId>> = vec![Vec::new(); t.names.len()];
+        for (name, ps) in &types {
+            let child = t.ids[*name];
+            for p in ps {
+                match t.ids.get(*p) {
+                    Some(&pid) if pid != child => parents[child as usize].push(pid),
+                    Some(_) => {}
+                    None => return Err(format!("type `{name}` has an undeclared parent `{p}`")),
+                }
+            }
+        }
+        t.parents = parents;
+        t.close();
+        Ok(t)
+    }
+
+    /// Computes every type's ancestors from the parents.
+    fn close(&mut self) {
+        let n = self.names.len();
+        self.ancestors = (0..n as TypeId)
+            .map(|id| {
+                let mut seen = vec![false; n];
+                let mut stack = vec![id];
+                while let Some(x) = stack.pop() {
+                    if !std::mem::replace(&mut seen[x as usize], true) {
+                        stack.extend(&self.parents[x as usize]);
+                    }
+                }
+                seen[OBJECT as usize] = true;
+                (0..n as TypeId).filter(|&i| seen[i as usize]).collect()
+            })
+            .collect();
+    }
+
+    /// The declared parents of a type (empty: `object`).
+    pub fn parents(&self, id: TypeId) -> &[TypeId] {
+        &self.parents[id as usize]
+    }
+
     fn intern(&mut self, name: &str) -> TypeId {
         if let Some(&id) = self.ids.get(name) {
             return id;
@@ -101,6 +142,7 @@ impl TypeTable {
         self.names.push(name.to_owned());
         self.ids.insert(name.to_owned(), id);
         self.ancestors.push(vec![OBJECT, id]);
+        self.parents.push(Vec::new());
         id
     }
 

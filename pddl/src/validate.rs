@@ -1,10 +1,11 @@
 //! Plan validation: replays a typed plan from the initial state and reports
 //! the first step whose precondition fails, or the goal literals it misses.
 
-use crate::ast::{Action, Domain, Effect, Formula, Problem};
+use crate::ast::{Action, Domain, Formula, Problem};
 use crate::diagnostic::{codes, Diagnostic};
+use crate::logic::{self, ActionSchema};
 use crate::plan::{GroundStep, Plan};
-use crate::state::{Changes, Env, State, World};
+use crate::state::{Changes, CompiledAction, Cond, Eff, State, World};
 use serde::Serialize;
 
 #[derive(Clone, Debug, Serialize)]
@@ -18,12 +19,23 @@ pub struct Validation {
     pub diagnostics: Vec<Diagnostic>,
 }
 
-/// Replays `steps` (from [`crate::plan::type_plan`], with no typing errors).
-pub fn validate(world: &World, problem: &Problem, plan: &Plan, steps: &[GroundStep]) -> Validation {
-    let mut state = world.initial_state(problem);
+/// Replays `steps` (from [`crate::plan::type_plan`], with no typing
+/// errors) on `world`, the world of `domain` and `problem`.
+pub fn validate(
+    world: &World,
+    domain: &Domain,
+    problem: &Problem,
+    plan: &Plan,
+    steps: &[GroundStep],
+) -> Validation {
+    let mut state = world.initial_state();
     let mut diags = Vec::new();
+    let mut actions = Actions::new(world, domain);
     for (n, g) in steps.iter().enumerate() {
-        if let Err(d) = apply_step(world, &mut state, plan, g) {
+        let applied = actions
+            .get(g.action)
+            .and_then(|a| apply_step(world, &a, &mut state, plan, g));
+        if let Err(d) = applied {
             diags.push(d);
             return Validation {
                 valid: false,
@@ -35,8 +47,8 @@ pub fn validate(world: &World, problem: &Problem, plan: &Plan, steps: &[GroundSt
     }
     let cost = cost(world, &state, steps.len());
     let mut valid = true;
-    if let Some(goal) = &problem.goal {
-        let missing = missing_goals(world, &state, goal);
+    if let (Some(goal), Some(cond)) = (&problem.goal, world.goal()) {
+        let missing = missing_goals(world, &state, goal, cond);
         if !missing.is_empty() {
             valid = false;
             let shown: Vec<String> = missing.iter().take(8).cloned().collect();
@@ -81,58 +93,93 @@ pub fn validate(world: &World, problem: &Problem, plan: &Plan, steps: &[GroundSt
     }
 }
 
+/// The domain's actions, each converted and compiled once, when a step
+/// first uses it.
+struct Actions<'a> {
+    world: &'a World,
+    domain: &'a Domain,
+    compiled: Vec<Option<std::rc::Rc<CompiledAction>>>,
+}
+
+impl<'a> Actions<'a> {
+    fn new(world: &'a World, domain: &'a Domain) -> Actions<'a> {
+        Actions {
+            world,
+            domain,
+            compiled: vec![None; domain.actions.len()],
+        }
+    }
+
+    fn get(&mut self, i: usize) -> Result<Step<'a>, Diagnostic> {
+        let ast = &self.domain.actions[i];
+        if self.compiled[i].is_none() {
+            let c = self
+                .world
+                .compile_action(&ActionSchema::from_ast(ast))
+                .map_err(|m| {
+                    Diagnostic::error(
+                        codes::PRECONDITION_FAILS,
+                        ast.name.span,
+                        format!("action `{}` does not fit the problem: {m}", ast.name.name),
+                    )
+                })?;
+            self.compiled[i] = Some(std::rc::Rc::new(c));
+        }
+        Ok(Step {
+            ast,
+            compiled: self.compiled[i].clone().expect("compiled above"),
+        })
+    }
+}
+
+/// An action as the AST has it (for spans) and compiled (to evaluate).
+struct Step<'a> {
+    ast: &'a Action,
+    compiled: std::rc::Rc<CompiledAction>,
+}
+
 fn cost(world: &World, state: &State, steps: usize) -> f64 {
-    match world.dix.functions.get("total-cost") {
-        Some(sig) => state
-            .fluents
-            .get(&[sig.index as u32][..])
-            .copied()
-            .unwrap_or(0.0),
+    match world.function_id("total-cost") {
+        Some(f) => state.fluents.get(&[f][..]).copied().unwrap_or(0.0),
         None => steps as f64,
     }
 }
 
 /// Goal conjuncts that do not hold, each explained.
-fn missing_goals(world: &World, state: &State, goal: &Formula) -> Vec<String> {
-    let mut env = Env::new();
-    match goal {
-        Formula::And { parts, .. } => parts
+fn missing_goals(world: &World, state: &State, goal: &Formula, cond: &Cond) -> Vec<String> {
+    let mut b = Vec::new();
+    match (goal, cond) {
+        (Formula::And { parts, .. }, Cond::And(conds)) => parts
             .iter()
-            .filter(|p| !world.holds(state, p, &mut Env::new(), None))
-            .flat_map(|p| missing_goals(world, state, p))
+            .zip(conds)
+            .filter(|(_, c)| !world.holds(state, c, &mut Vec::new(), None))
+            .flat_map(|(p, c)| missing_goals(world, state, p, c))
             .collect(),
-        g if !world.holds(state, g, &mut env, None) => {
-            vec![world.why_not(state, g, &mut env, None).0]
+        _ if !world.holds(state, cond, &mut b, None) => {
+            vec![world.why_not(state, cond, &mut b, None).0]
         }
         _ => Vec::new(),
     }
 }
 
-fn bind<'a>(action: &'a Action, g: &GroundStep) -> Env<'a> {
-    action
-        .params
-        .iter()
-        .map(|p| p.name.as_str())
-        .zip(g.args.iter().copied())
-        .collect()
-}
-
 /// Applies one step: durative actions as start conditions, start effects,
 /// over-all and end conditions, end effects.
-pub fn apply_step(
+fn apply_step(
     world: &World,
+    action: &Step,
     state: &mut State,
     plan: &Plan,
     g: &GroundStep,
 ) -> Result<(), Diagnostic> {
-    let action = &world.domain.actions[g.action];
+    let c = &action.compiled;
+    let a = action.ast;
     let step = &plan.steps[g.step];
-    let mut env = bind(action, g);
-    let duration = match &action.duration {
-        Some(d) => world.value(state, &d.value, &env, None).or(step.duration),
+    let mut binding = g.args.clone();
+    let duration = match &c.duration {
+        Some(d) => world.value(state, d, &binding, None).or(step.duration),
         None => step.duration,
     };
-    let start_phase = if action.durative {
+    let start_phase = if a.durative {
         "its `at start` condition"
     } else {
         "its precondition"
@@ -141,43 +188,51 @@ pub fn apply_step(
         world,
         plan,
         g,
-        action,
+        action: a,
         duration,
     };
-    ctx.check(state, &action.pre_start, &mut env, start_phase)?;
-    if action.durative {
-        ctx.apply_effects(state, &action.eff_start, &mut env)?;
+    ctx.check(state, &c.pre_start, &a.pre_start, &mut binding, start_phase)?;
+    if a.durative {
+        ctx.apply_effects(state, &c.eff_start, &mut binding)?;
         ctx.check(
             state,
-            &action.pre_over_all,
-            &mut env,
+            &c.pre_over_all,
+            &a.pre_over_all,
+            &mut binding,
             "its `over all` condition",
         )?;
-        ctx.check(state, &action.pre_end, &mut env, "its `at end` condition")?;
+        ctx.check(
+            state,
+            &c.pre_end,
+            &a.pre_end,
+            &mut binding,
+            "its `at end` condition",
+        )?;
     }
-    ctx.apply_effects(state, &action.eff_end, &mut env)
+    ctx.apply_effects(state, &c.eff_end, &mut binding)
 }
 
-struct StepCtx<'w, 'a> {
-    world: &'w World<'w>,
+struct StepCtx<'w> {
+    world: &'w World,
     plan: &'w Plan,
     g: &'w GroundStep,
-    action: &'a Action,
+    action: &'w Action,
     duration: Option<f64>,
 }
 
-impl<'a> StepCtx<'_, 'a> {
+impl StepCtx<'_> {
     fn check(
         &self,
         state: &State,
-        conds: &'a [Formula],
-        env: &mut Env<'a>,
+        conds: &[Cond],
+        written: &[Formula],
+        binding: &mut Vec<u32>,
         phase: &str,
     ) -> Result<(), Diagnostic> {
         let (world, g) = (self.world, self.g);
-        for c in conds {
-            if !world.holds(state, c, env, self.duration) {
-                let (why, at) = world.why_not(state, c, env, self.duration);
+        for (c, f) in conds.iter().zip(written) {
+            if !world.holds(state, c, binding, self.duration) {
+                let (why, path) = world.why_not(state, c, binding, self.duration);
                 return Err(Diagnostic::error(
                     codes::PRECONDITION_FAILS,
                     self.plan.steps[g.step].span,
@@ -187,7 +242,7 @@ impl<'a> StepCtx<'_, 'a> {
                         show_step(world, self.action, g)
                     ),
                 )
-                .with_label(at, "this condition fails"));
+                .with_label(logic::span_at(f, &path), "this condition fails"));
             }
         }
         Ok(())
@@ -196,13 +251,13 @@ impl<'a> StepCtx<'_, 'a> {
     fn apply_effects(
         &self,
         state: &mut State,
-        effects: &'a [Effect],
-        env: &mut Env<'a>,
+        effects: &[Eff],
+        binding: &mut Vec<u32>,
     ) -> Result<(), Diagnostic> {
         let (world, g) = (self.world, self.g);
         let mut changes = Changes::default();
         for e in effects {
-            world.collect_effect(state, e, env, self.duration, &mut changes);
+            world.collect(state, e, binding, self.duration, &mut changes);
         }
         if let Some(err) = changes.numeric_errors.first() {
             return Err(Diagnostic::error(
@@ -229,13 +284,13 @@ pub fn show_step(world: &World, action: &Action, g: &GroundStep) -> String {
     let mut s = format!("({}", action.name.name);
     for &o in &g.args {
         s.push(' ');
-        s.push_str(&world.pix.object_names[o as usize]);
+        s.push_str(world.object_name(o));
     }
     s.push(')');
     s
 }
 
-/// Convenience for callers with a domain and problem at hand.
+/// Convenience for callers with a checked domain and problem at hand.
 pub fn validate_plan(
     domain: &Domain,
     problem: &Problem,
@@ -243,7 +298,7 @@ pub fn validate_plan(
     pix: &crate::ProblemIndex,
     plan: &Plan,
     steps: &[GroundStep],
-) -> Validation {
-    let world = World::new(domain, dix, pix);
-    validate(&world, problem, plan, steps)
+) -> Result<Validation, String> {
+    let world = World::of_checked(domain, dix, problem, pix)?;
+    Ok(validate(&world, domain, problem, plan, steps))
 }

@@ -19,7 +19,8 @@
 //! let problem = pu.problem.as_ref().unwrap();
 //!
 //! // A knowledge base: the problem's facts, then what execution changed.
-//! let mut kb = World::new(domain, &du.index, &pu.index).initial_state(problem);
+//! let world = World::of_checked(domain, &du.index, problem, &pu.index).unwrap();
+//! let mut kb = world.initial_state();
 //! let key = |pred: &str, args: &[&str]| -> Box<[u32]> {
 //!     let mut k = vec![du.index.predicates[pred].index as u32];
 //!     k.extend(args.iter().map(|a| pu.index.objects[*a].id));
@@ -50,7 +51,7 @@ pub use search::{Algorithm, Options, SearchStats};
 use btc_pddl::ast::{Domain, Formula, InitFact, Problem};
 use btc_pddl::check::{DomainIndex, ProblemIndex};
 use btc_pddl::diagnostic::{codes, Diagnostic};
-use btc_pddl::state::{State, World};
+use btc_pddl::state::{Key, State};
 use std::time::{Duration, Instant};
 
 /// One step of a plan: an action of the domain and its arguments (object
@@ -98,21 +99,35 @@ pub fn plan(
     pix: &ProblemIndex,
     opts: &Options,
 ) -> Result<Report, Vec<Diagnostic>> {
-    let world = World::new(domain, dix, pix);
     // The facts and values of `:init`; derived atoms are the planner's job.
     let mut init = State::default();
-    let env = Vec::new();
     for f in &problem.init {
         match f {
-            InitFact::Atom { atom } => init.facts.extend(world.atom_key(atom, &env)),
+            InitFact::Atom { atom } => init.facts.extend(ground_key(&dix.predicates, pix, atom)),
             InitFact::Value { fluent, value, .. } => {
-                if let Some(k) = world.fluent_key(fluent, &env) {
+                if let Some(k) = ground_key(&dix.functions, pix, fluent) {
                     init.fluents.insert(k, *value);
                 }
             }
         }
     }
     plan_from(domain, dix, pix, &init, problem.goal.as_ref(), opts)
+}
+
+/// The key of a ground atom of `:init` (`None` for what the checks refuse).
+fn ground_key(
+    heads: &rustc_hash::FxHashMap<String, btc_pddl::check::Signature>,
+    pix: &ProblemIndex,
+    atom: &btc_pddl::ast::Atom,
+) -> Option<Key> {
+    let mut k = vec![heads.get(atom.pred.as_str())?.index as u32];
+    for t in &atom.args {
+        match t {
+            btc_pddl::ast::Term::Const { name } => k.push(pix.objects.get(name.as_str())?.id),
+            btc_pddl::ast::Term::Var { .. } => return None,
+        }
+    }
+    Some(k.into_boxed_slice())
 }
 
 /// Plans from `initial` (facts and numeric values over the problem's
@@ -238,8 +253,8 @@ pub(crate) mod test_util {
         let d = du.domain.as_ref().expect("domain parses");
         let pu = problem_unit_from(problem, 1, Some(d), &du.index);
         let p = pu.problem.as_ref().expect("problem parses");
-        let world = World::new(d, &du.index, &pu.index);
-        let init = world.initial_state(p);
+        let world = World::of_checked(d, &du.index, p, &pu.index).expect("a world");
+        let init = world.initial_state();
         crate::ground::ground(d, &du.index, &pu.index, &init, p.goal.as_ref(), None)
             .expect("grounds")
             .expect("no time limit")

@@ -180,7 +180,9 @@ fn lm_cut_lies_between_h_max_and_the_optimal_cost() {
             l.du.domain.as_ref().unwrap(),
             l.pu.problem.as_ref().unwrap(),
         );
-        let init = World::new(dom, &l.du.index, &l.pu.index).initial_state(prob);
+        let init = World::of_checked(dom, &l.du.index, prob, &l.pu.index)
+            .unwrap()
+            .initial_state();
         let (task, _) = btc_planner::ground::ground(
             dom,
             &l.du.index,

@@ -81,8 +81,8 @@ fn planning_from_a_knowledge_base_state() {
         l.du.domain.as_ref().unwrap(),
         l.pu.problem.as_ref().unwrap(),
     );
-    let world = World::new(domain, &l.du.index, &l.pu.index);
-    let mut kb = world.initial_state(problem);
+    let world = World::of_checked(domain, &l.du.index, problem, &l.pu.index).unwrap();
+    let mut kb = world.initial_state();
     let key = |pred: &str, args: &[&str]| -> Box<[u32]> {
         let mut k = vec![l.du.index.predicates[pred].index as u32];
         k.extend(args.iter().map(|a| l.pu.index.objects[*a].id));

@@ -134,12 +134,14 @@ const FLAGS_PROBLEM: &str = include_str!("../tests/fixtures/flags/problem.pddl")
 fn reactive_kb_monitor_over_100_actions(b: Bencher) {
     let du = pipeline::domain_unit_from(FLAGS_DOMAIN, 0);
     let pu = pipeline::problem_unit_from(FLAGS_PROBLEM, 1, du.domain.as_ref(), &du.index);
-    let kb = Kb::new(
+    let world = btc_pddl::state::World::of_checked(
         du.domain.as_ref().unwrap(),
         &du.index,
         pu.problem.as_ref().unwrap(),
         &pu.index,
-    );
+    )
+    .unwrap();
+    let kb = Kb::new(&world);
     let cond = node(
         Kind::Leaf {
             id: "KbHolds".into(),

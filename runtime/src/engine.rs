@@ -7,10 +7,11 @@
 use crate::controller::{Command, Controller};
 use crate::error::LoadError;
 use crate::faults::FaultRt;
-use crate::kb::{substitute, EffectId, FormulaId, Kb};
+use crate::kb::{ConditionId, EffectId, FormulaId, Kb};
 use crate::spec::{default_name, Kind, SNode, TreeDoc};
-use btc_ir::{LeafKind, PortValue};
+use btc_ir::{LeafKind, NodeModel, PortValue};
 use btc_pddl::diagnostic::{codes, did_you_mean};
+use btc_pddl::logic::{self, Binding, Effect, Formula, Name, Terms};
 use rustc_hash::FxHashMap;
 use serde::Serialize;
 use std::rc::Rc;
@@ -169,11 +170,15 @@ pub(crate) struct ActionInfo {
 }
 
 pub(crate) struct CondInfo {
-    pub ports: (u32, u32),
-    /// The model's formula over `?port` variables.
-    pub template: Option<Box<str>>,
-    /// The ground formula, and the blackboard generation it was made for.
-    pub ground: Option<FormulaId>,
+    /// The model's formula, compiled over the ports it names (`None`: a
+    /// condition the executor implements, simulated as SUCCESS).
+    pub formula: Option<ConditionId>,
+    /// For each slot of the formula, the port (an index into
+    /// `Engine::ports`) whose object fills it.
+    pub slot_ports: Box<[u32]>,
+    /// The ports' objects at blackboard generation `generation`, or why a
+    /// port names no object.
+    pub objects: Result<Vec<u32>, String>,
     pub generation: u64,
 }
 
@@ -210,6 +215,8 @@ pub(crate) enum Reason {
     Precondition(FormulaId),
     EndCondition(FormulaId),
     ConditionFalse(FormulaId),
+    /// A formula-defined condition with these objects in its ports.
+    PortsFalse(ConditionId, Vec<u32>),
     Fault(usize, String),
     Plain(String),
 }
@@ -314,6 +321,10 @@ type Scope = FxHashMap<String, u32>;
 
 struct Builder<'d, 'e, 'w> {
     doc: &'d TreeDoc,
+    /// The document's trees and node models by ID: looking them up in the
+    /// lists per node made loading quadratic.
+    trees: FxHashMap<&'d str, &'d SNode>,
+    models: FxHashMap<&'d str, &'d NodeModel>,
     e: &'e mut Engine<'w>,
     instances: FxHashMap<String, u32>,
     /// The tree instance being built (`Main`, `Check#1`): names new entries.
@@ -374,6 +385,19 @@ impl<'w> Engine<'w> {
         }
         let mut b = Builder {
             doc,
+            // The first definition of an ID counts, as `TreeDoc::tree` has it.
+            trees: doc
+                .trees
+                .iter()
+                .rev()
+                .map(|(id, n)| (id.as_str(), n))
+                .collect(),
+            models: doc
+                .models
+                .iter()
+                .rev()
+                .map(|m| (m.id.as_str(), m))
+                .collect(),
             e: &mut e,
             instances: FxHashMap::default(),
             tree: doc.main.clone(),
@@ -395,11 +419,11 @@ impl<'w> Engine<'w> {
                 ..StepRt::default()
             };
             if !s.skipped {
-                rt.pre_start = self.kb_formula(s.pre_start.as_deref(), &rt.label)?;
-                rt.pre_over_all = self.kb_formula(s.pre_over_all.as_deref(), &rt.label)?;
-                rt.pre_end = self.kb_formula(s.pre_end.as_deref(), &rt.label)?;
-                rt.eff_start = self.kb_effect(s.eff_start.as_deref(), &rt.label)?;
-                rt.eff_end = self.kb_effect(s.eff_end.as_deref(), &rt.label)?;
+                rt.pre_start = self.kb_formula_text(s.pre_start.as_deref(), &rt.label)?;
+                rt.pre_over_all = self.kb_formula_text(s.pre_over_all.as_deref(), &rt.label)?;
+                rt.pre_end = self.kb_formula_text(s.pre_end.as_deref(), &rt.label)?;
+                rt.eff_start = self.kb_effect_text(s.eff_start.as_deref(), &rt.label)?;
+                rt.eff_end = self.kb_effect_text(s.eff_end.as_deref(), &rt.label)?;
             }
             self.steps.push(rt);
         }
@@ -412,32 +436,58 @@ impl<'w> Engine<'w> {
 
     fn kb_formula(
         &mut self,
+        f: Option<&Formula>,
+        what: &str,
+    ) -> Result<Option<FormulaId>, LoadError> {
+        let Some(f) = f else {
+            return Ok(None);
+        };
+        let kb = self.need_kb(what)?;
+        kb.formula(f).map(Some).map_err(|m| {
+            LoadError::new(
+                codes::X_KB,
+                format!("{what}: `{f}` is not a condition of this problem: {m}"),
+            )
+        })
+    }
+
+    fn kb_effect(&mut self, e: Option<&Effect>, what: &str) -> Result<Option<EffectId>, LoadError> {
+        let Some(e) = e else {
+            return Ok(None);
+        };
+        let kb = self.need_kb(what)?;
+        kb.effect(e).map(Some).map_err(|m| {
+            LoadError::new(
+                codes::X_KB,
+                format!("{what}: `{e}` is not an effect of this problem: {m}"),
+            )
+        })
+    }
+
+    /// [`Engine::kb_formula`] of PDDL text (the IR's version 1 strings).
+    fn kb_formula_text(
+        &mut self,
         text: Option<&str>,
         what: &str,
     ) -> Result<Option<FormulaId>, LoadError> {
         let Some(t) = text.filter(|t| !t.trim().is_empty()) else {
             return Ok(None);
         };
-        let kb = self.need_kb(what)?;
-        kb.formula(t).map(Some).map_err(|m| {
-            LoadError::new(
-                codes::X_KB,
-                format!("{what}: `{t}` is not a condition of this problem: {m}"),
-            )
-        })
+        let f = decoded(btc_pddl::logic::decode::formula(t), t, what, "a condition")?;
+        self.kb_formula(Some(&f), what)
     }
 
-    fn kb_effect(&mut self, text: Option<&str>, what: &str) -> Result<Option<EffectId>, LoadError> {
+    /// [`Engine::kb_effect`] of PDDL text.
+    fn kb_effect_text(
+        &mut self,
+        text: Option<&str>,
+        what: &str,
+    ) -> Result<Option<EffectId>, LoadError> {
         let Some(t) = text.filter(|t| !t.trim().is_empty()) else {
             return Ok(None);
         };
-        let kb = self.need_kb(what)?;
-        kb.effect(t).map(Some).map_err(|m| {
-            LoadError::new(
-                codes::X_KB,
-                format!("{what}: `{t}` is not an effect of this problem: {m}"),
-            )
-        })
+        let e = decoded(btc_pddl::logic::decode::effect(t), t, what, "an effect")?;
+        self.kb_effect(Some(&e), what)
     }
 
     fn new_slot(&mut self, name: String, v: Value) -> u32 {
@@ -525,7 +575,11 @@ impl<'w> Engine<'w> {
 
     /// Ticks until the root is no longer RUNNING, or `max_ticks` have run
     /// (then the tree is halted). `each` sees the engine after every tick.
-    pub fn run(&mut self, max_ticks: u64, mut each: impl FnMut(&Engine<'w>)) -> Status {
+    pub fn run(&mut self, max_ticks: u64, mut each: impl FnMut(&mut Engine<'w>)) -> Status {
+        if max_ticks == 0 {
+            self.finish(Status::Running);
+            return Status::Running;
+        }
         loop {
             let s = self.tick_once();
             each(self);
@@ -544,14 +598,30 @@ impl<'w> Engine<'w> {
         }
     }
 
+    /// One tick as [`Engine::run`] makes it: once the root is done, the
+    /// failure that ended it (or the goal that does not hold) is recorded.
+    /// The task level (`btc trial`) ticks several engines on one clock this
+    /// way.
+    pub fn step(&mut self) -> Status {
+        let s = self.tick_once();
+        if s != Status::Running {
+            self.finish(s);
+        }
+        s
+    }
+
     /// Ticks like [`Engine::run`], but halts the tree and returns
     /// `(Status::Running, true)` as soon as `stop` says so after a tick
     /// (replanning preempts a plan this way).
     pub fn run_until(
         &mut self,
         max_ticks: u64,
-        mut stop: impl FnMut(&Engine<'w>) -> bool,
+        mut stop: impl FnMut(&mut Engine<'w>) -> bool,
     ) -> (Status, bool) {
+        if max_ticks == 0 {
+            self.finish(Status::Running);
+            return (Status::Running, false);
+        }
         loop {
             let s = self.tick_once();
             if s != Status::Running {
@@ -979,46 +1049,53 @@ impl<'w> Engine<'w> {
 
     fn tick_condition(&mut self, i: u32, c: u32) -> Status {
         let cu = c as usize;
-        if self.conds[cu].template.is_none() {
+        let Some(formula) = self.conds[cu].formula else {
             return Status::Success;
-        }
+        };
         if let Some(s) = self.blackout() {
             if s == Status::Failure {
                 self.note_blackout(i);
             }
             return s;
         }
-        if self.conds[cu].generation != self.bb_gen || self.conds[cu].ground.is_none() {
-            let text = self.ground_condition(cu);
-            let f = self.kb.as_mut().map(|kb| kb.formula(&text));
+        if self.conds[cu].generation != self.bb_gen {
+            self.conds[cu].objects = self.port_objects(&self.conds[cu].slot_ports);
             self.conds[cu].generation = self.bb_gen;
-            match f {
-                Some(Ok(f)) => self.conds[cu].ground = Some(f),
-                Some(Err(m)) => {
-                    self.conds[cu].ground = None;
-                    self.note_failure(i, Reason::Plain(format!("`{text}`: {m}")));
-                    return Status::Failure;
-                }
-                None => return Status::Failure,
-            }
         }
-        match self.conds[cu].ground {
-            Some(f) => self.check(i, f),
-            None => Status::Failure,
+        let Some(kb) = self.kb.as_ref() else {
+            return Status::Failure;
+        };
+        match &self.conds[cu].objects {
+            Ok(objects) if kb.holds_with(formula, objects) => Status::Success,
+            Ok(objects) => {
+                let r = Reason::PortsFalse(formula, objects.clone());
+                self.note_failure(i, r);
+                Status::Failure
+            }
+            Err(m) => {
+                let r = Reason::Plain(m.clone());
+                self.note_failure(i, r);
+                Status::Failure
+            }
         }
     }
 
-    /// The condition's formula with its ports' current values filled in.
-    fn ground_condition(&self, cu: usize) -> String {
-        let info = &self.conds[cu];
-        let template = info.template.as_deref().unwrap_or("");
-        let (a, b) = info.ports;
-        substitute(template, |var| {
-            self.ports[a as usize..b as usize]
-                .iter()
-                .find(|p| &*p.name == var)
-                .map(|p| self.value(&p.src).text())
-        })
+    /// The objects a formula-defined condition's ports name now.
+    fn port_objects(&self, slot_ports: &[u32]) -> Result<Vec<u32>, String> {
+        let kb = self.kb.as_ref().ok_or("no knowledge base")?;
+        slot_ports
+            .iter()
+            .map(|&p| {
+                let port = &self.ports[p as usize];
+                let v = self.value(&port.src).text();
+                kb.object(&v).ok_or_else(|| {
+                    format!(
+                        "port `{}` holds `{v}`, which is not an object of this problem",
+                        port.name
+                    )
+                })
+            })
+            .collect()
     }
 
     fn tick_action(&mut self, i: u32, a: u32) -> Status {
@@ -1138,6 +1215,12 @@ impl<'w> Engine<'w> {
             Reason::ConditionFalse(f) => kb.map_or_else(String::new, |kb| {
                 format!("the condition does not hold: {}", kb.why_not(*f))
             }),
+            Reason::PortsFalse(c, objects) => kb.map_or_else(String::new, |kb| {
+                format!(
+                    "the condition does not hold: {}",
+                    kb.why_not_with(*c, objects)
+                )
+            }),
             Reason::Fault(_, s) | Reason::Plain(s) => s.clone(),
         }
     }
@@ -1213,7 +1296,32 @@ impl<'w> Engine<'w> {
     pub fn trace_jsonl(&self) -> String {
         let mut out = String::new();
         for t in &self.trace {
-            let v = match t {
+            out.push_str(&self.trace_line(t).to_string());
+            out.push('\n');
+        }
+        out
+    }
+
+    /// Writes the trace so far as JSON Lines and forgets it, so that a long
+    /// run streams its trace in bounded memory (`btc run --trace` calls this
+    /// after every tick).
+    pub fn drain_trace(&mut self, out: &mut dyn std::io::Write) -> std::io::Result<()> {
+        let items = std::mem::take(&mut self.trace);
+        let mut line = Vec::new();
+        for t in &items {
+            line.clear();
+            serde_json::to_writer(&mut line, &self.trace_line(t))?;
+            line.push(b'\n');
+            out.write_all(&line)?;
+        }
+        self.trace = items;
+        self.trace.clear();
+        Ok(())
+    }
+
+    fn trace_line(&self, t: &TraceItem) -> serde_json::Value {
+        {
+            match t {
                 TraceItem::Status {
                     tick,
                     node,
@@ -1252,12 +1360,19 @@ impl<'w> Engine<'w> {
                     "tick": tick, "event": "command", "seq": seq, "node": node,
                     "command": self.meta[*node as usize].id,
                 }),
-            };
-            out.push_str(&v.to_string());
-            out.push('\n');
+            }
         }
-        out
     }
+}
+
+/// A decoded formula or effect, or X005 naming what it should have been.
+fn decoded<T>(r: Result<T, String>, text: &str, what: &str, kind: &str) -> Result<T, LoadError> {
+    r.map_err(|m| {
+        LoadError::new(
+            codes::X_KB,
+            format!("{what}: `{text}` is not {kind} of this problem: {m}"),
+        )
+    })
 }
 
 fn no_kb(what: &str) -> LoadError {
@@ -1409,14 +1524,14 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
                 let label = format!("`{}`", self.e.steps[*k].label);
                 if let Some(f) = self
                     .e
-                    .kb_effect(start_effect.as_deref(), &label)
+                    .kb_effect_text(start_effect.as_deref(), &label)
                     .map_err(|e| e.at_opt(n.at))?
                 {
                     self.e.steps[*k].eff_start = Some(f);
                 }
                 if let Some(f) = self
                     .e
-                    .kb_effect(end_effect.as_deref(), &label)
+                    .kb_effect_text(end_effect.as_deref(), &label)
                     .map_err(|e| e.at_opt(n.at))?
                 {
                     self.e.steps[*k].eff_end = Some(f);
@@ -1466,7 +1581,7 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
                     "a SubTree has no children of its own".into(),
                 ));
             }
-            let Some(def) = self.doc.tree(tid) else {
+            let Some(def) = self.trees.get(tid.as_str()).copied() else {
                 let hint = did_you_mean(tid, self.doc.trees.iter().map(|(t, _)| t.as_str()));
                 let mut e = self.err(
                     codes::X_SUBTREE,
@@ -1525,9 +1640,6 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
     /// A step known only from a tree file (`KbStep name="step 3: (grasp r
     /// p bin1)"`): its conditions are the domain action's, grounded.
     fn derive_step(&mut self, k: usize, name: &str) -> Result<(), LoadError> {
-        let Some(domain) = self.e.kb.as_ref().map(|kb| kb.world.domain) else {
-            return Ok(());
-        };
         let Some(open) = name.find('(') else {
             return Ok(());
         };
@@ -1536,36 +1648,38 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
         let Some(act) = words.next().map(str::to_lowercase) else {
             return Ok(());
         };
-        let args: Vec<String> = words.map(str::to_lowercase).collect();
-        let Some(a) = domain.actions.iter().find(|a| a.name.name == act) else {
+        let args: Vec<Name> = words.map(|w| logic::name(&w.to_lowercase())).collect();
+        let Some(a) = self.doc.actions.iter().find(|a| *a.name == *act) else {
             return Ok(());
         };
         if a.params.len() != args.len() {
             return Ok(());
         }
-        let bind = |v: &str| {
-            a.params
-                .iter()
-                .position(|p| p.name.name == v)
-                .map(|i| args[i].clone())
+        let params = a.param_names();
+        let binding = Binding {
+            params: &params,
+            objects: &args,
         };
-        let text = |parts: &[btc_pddl::ast::Formula]| {
-            (!parts.is_empty()).then(|| substitute(&btc_pddl::print::conjunction(parts), bind))
+        let ground = |parts: &[Formula]| {
+            Formula::conjunction(parts.iter().map(|f| f.ground(&binding)).collect())
         };
-        let (pre_start, over_all, pre_end) =
-            (text(&a.pre_start), text(&a.pre_over_all), text(&a.pre_end));
+        let (pre_start, over_all, pre_end) = (
+            ground(&a.pre_start),
+            ground(&a.pre_over_all),
+            ground(&a.pre_end),
+        );
         let label = format!(
             "step {}: ({})",
             k + 1,
             std::iter::once(act.as_str())
-                .chain(args.iter().map(String::as_str))
+                .chain(args.iter().map(|a| &**a))
                 .collect::<Vec<_>>()
                 .join(" ")
         );
         let what = format!("`{label}`");
-        let pre_start = self.e.kb_formula(pre_start.as_deref(), &what)?;
-        let over_all = self.e.kb_formula(over_all.as_deref(), &what)?;
-        let pre_end = self.e.kb_formula(pre_end.as_deref(), &what)?;
+        let pre_start = self.e.kb_formula(pre_start.as_ref(), &what)?;
+        let over_all = self.e.kb_formula(over_all.as_ref(), &what)?;
+        let pre_end = self.e.kb_formula(pre_end.as_ref(), &what)?;
         let st = &mut self.e.steps[k];
         st.label = label;
         st.pre_start = pre_start;
@@ -1646,6 +1760,53 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
         }
     }
 
+    /// A condition's formula compiled over the ports it names: its free
+    /// variables are port names, each a slot filled from that port. With
+    /// constant ports only, the objects are checked now.
+    fn port_condition(
+        &mut self,
+        n: &SNode,
+        id: &str,
+        f: &Formula,
+        range: (u32, u32),
+    ) -> Result<(ConditionId, Box<[u32]>), LoadError> {
+        let what = format!("the condition `{id}`");
+        let vars = f.free_vars();
+        let mut slots = Vec::with_capacity(vars.len());
+        for v in &vars {
+            let p = (range.0..range.1).find(|&p| *self.e.ports[p as usize].name == **v);
+            match p {
+                Some(p) => slots.push(p),
+                None => {
+                    return Err(self.err(
+                        codes::X_KB,
+                        n,
+                        format!(
+                            "{what}: its formula `{f}` reads `?{v}`, which is none of its ports"
+                        ),
+                    ))
+                }
+            }
+        }
+        let kb = self.e.need_kb(&what).map_err(|e| e.at_opt(n.at))?;
+        let c = kb.condition(f, &vars).map_err(|m| {
+            self.err(
+                codes::X_KB,
+                n,
+                format!("{what}: `{f}` is not a condition of this problem: {m}"),
+            )
+        })?;
+        let all_const = slots
+            .iter()
+            .all(|&p| matches!(self.e.ports[p as usize].src, Src::Const(_)));
+        if all_const {
+            if let Err(m) = self.e.port_objects(&slots) {
+                return Err(self.err(codes::X_KB, n, format!("{what}: {m}")));
+            }
+        }
+        Ok((c, slots.into()))
+    }
+
     fn leaf(
         &mut self,
         n: &SNode,
@@ -1702,7 +1863,7 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
                 let t = self.const_text(n, ports, "formula", true)?;
                 let f = self
                     .e
-                    .kb_formula(t.as_deref(), &what)
+                    .kb_formula_text(t.as_deref(), &what)
                     .map_err(|e| e.at_opt(n.at))?;
                 return match f {
                     Some(f) => Ok(Op::KbHolds(f)),
@@ -1713,7 +1874,7 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
                 let t = self.const_text(n, ports, "effect", true)?;
                 let f = self
                     .e
-                    .kb_effect(t.as_deref(), &what)
+                    .kb_effect_text(t.as_deref(), &what)
                     .map_err(|e| e.at_opt(n.at))?;
                 return match f {
                     Some(f) => Ok(Op::KbApply(f)),
@@ -1733,7 +1894,7 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
             }
             _ => {}
         }
-        let model = self.doc.model(id);
+        let model = self.models.get(id).copied();
         let kind = kind.or(model.map(|m| m.kind)).ok_or_else(|| {
             let known = self.doc.models.iter().map(|m| m.id.as_str()).chain(BUILTIN_LEAVES.iter().copied());
             let mut e = self.err(
@@ -1753,30 +1914,34 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
         let range = self.bind_ports(n, ports, &types, scope)?;
         Ok(match kind {
             LeafKind::Condition => {
-                let template = model.and_then(|m| m.formula.clone());
-                if template.is_some() && self.e.kb.is_none() {
-                    return Err(no_kb(&format!("the condition `{id}`")).at_opt(n.at));
-                }
+                let formula = match model.and_then(|m| m.formula.as_deref()) {
+                    Some(text) => {
+                        let what = format!("the condition `{id}`");
+                        let f = decoded(
+                            btc_pddl::logic::decode::formula(text),
+                            text,
+                            &what,
+                            "a condition",
+                        )
+                        .map_err(|e| e.at_opt(n.at))?;
+                        Some(f)
+                    }
+                    None => None,
+                };
                 let c = self.e.conds.len() as u32;
+                let (compiled, slot_ports) = match &formula {
+                    Some(f) => {
+                        let (c, slots) = self.port_condition(n, id, f, range)?;
+                        (Some(c), slots)
+                    }
+                    None => (None, Box::default()),
+                };
                 self.e.conds.push(CondInfo {
-                    ports: range,
-                    template: template.map(Into::into),
-                    ground: None,
+                    formula: compiled,
+                    slot_ports,
+                    objects: Ok(Vec::new()),
                     generation: 0,
                 });
-                // Constant ports: check the ground formula now.
-                let all_const = self.e.ports[range.0 as usize..range.1 as usize]
-                    .iter()
-                    .all(|p| matches!(p.src, Src::Const(_)));
-                if all_const && self.e.conds[c as usize].template.is_some() {
-                    let text = self.e.ground_condition(c as usize);
-                    let f = self
-                        .e
-                        .kb_formula(Some(&text), &format!("the condition `{id}`"))
-                        .map_err(|e| e.at_opt(n.at))?;
-                    self.e.conds[c as usize].ground = f;
-                    self.e.conds[c as usize].generation = self.e.bb_gen;
-                }
                 Op::Condition(c)
             }
             LeafKind::Action => {

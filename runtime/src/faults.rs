@@ -5,6 +5,7 @@ use crate::engine::{Engine, Reason, Status, TraceItem};
 use crate::error::LoadError;
 use crate::kb::FormulaId;
 use btc_pddl::diagnostic::codes;
+use btc_pddl::logic::{decode, Atom, Formula, Terms};
 use btc_pddl::state::Key;
 use serde::{Deserialize, Serialize};
 
@@ -76,9 +77,9 @@ pub struct FaultSpec {
     pub robot: Option<String>,
     pub part: Option<String>,
     pub duration: Option<u64>,
-    pub retract: Option<Vec<String>>,
-    pub add: Vec<String>,
-    pub goal: Option<String>,
+    pub retract: Option<Vec<Atom>>,
+    pub add: Vec<Atom>,
+    pub goal: Option<Formula>,
     pub blackout: Blackout,
 }
 
@@ -223,6 +224,21 @@ impl Scenario {
                     )))
                 }
             };
+            // The scenario's PDDL text is read here, once.
+            let atoms = |list: &[String]| -> Result<Vec<Atom>, LoadError> {
+                list.iter()
+                    .map(|t| {
+                        decode::atom(t)
+                            .map_err(|m| bad(format!("{which}: `{t}` is not a PDDL fact: {m}")))
+                    })
+                    .collect()
+            };
+            let goal = match &f.goal {
+                Some(g) => Some(decode::formula(g).map_err(|m| {
+                    bad(format!("{which}: goal `{g}` is not a PDDL condition: {m}"))
+                })?),
+                None => None,
+            };
             faults.push(FaultSpec {
                 kind,
                 name: f.name,
@@ -230,9 +246,9 @@ impl Scenario {
                 robot: f.robot,
                 part: f.part,
                 duration: f.duration,
-                retract: f.retract,
-                add: f.add,
-                goal: f.goal,
+                retract: f.retract.as_deref().map(atoms).transpose()?,
+                add: atoms(&f.add)?,
+                goal,
                 blackout,
             });
         }
@@ -284,7 +300,7 @@ impl<'w> Engine<'w> {
                     ))
                 })?);
             }
-            let check_atoms = |kb: &mut crate::kb::Kb, list: &[String]| -> Result<(), LoadError> {
+            let check_atoms = |kb: &mut crate::kb::Kb, list: &[Atom]| -> Result<(), LoadError> {
                 for t in list {
                     kb.atom_key(t)
                         .map_err(|m| bad(format!("fault `{label}`: `{t}`: {m}")))?;
@@ -614,7 +630,11 @@ impl<'w> Engine<'w> {
             }
             let direct = matches!(r, Reason::Fault(g, _) if *g == f);
             let named = rt.shown.iter().any(|s| reason.contains(s.as_str()))
-                || rt.spec.goal.as_deref().is_some_and(|g| reason.contains(g));
+                || rt
+                    .spec
+                    .goal
+                    .as_ref()
+                    .is_some_and(|g| reason.contains(&g.to_string()));
             if direct || named || self.in_effect(f) {
                 out.push(rt.spec.label());
             }
@@ -654,13 +674,11 @@ impl<'w> Engine<'w> {
     }
 }
 
-/// The met faults that removed or added a fact `text` shows, or whose part
-/// or robot it names (`text`: a goal literal): their labels.
-pub fn naming(faults: &[FaultRt], text: &str) -> Vec<String> {
-    let words: Vec<&str> = text
-        .split(|c: char| c.is_whitespace() || c == '(' || c == ')')
-        .filter(|w| !w.is_empty())
-        .collect();
+/// The met faults that removed or added a fact `lit` mentions, or whose
+/// part or robot it names (`lit`: a goal literal): their labels.
+pub fn naming(faults: &[FaultRt], lit: &Formula) -> Vec<String> {
+    let objects = lit.objects();
+    let text = lit.to_string();
     faults
         .iter()
         .filter(|rt| rt.met_at.is_some())
@@ -668,7 +686,7 @@ pub fn naming(faults: &[FaultRt], text: &str) -> Vec<String> {
             [&rt.spec.part, &rt.spec.robot]
                 .into_iter()
                 .flatten()
-                .any(|o| words.contains(&o.as_str()))
+                .any(|o| objects.iter().any(|x| **x == **o))
                 || rt.shown.iter().any(|s| text.contains(s.as_str()))
         })
         .map(|rt| rt.spec.label())

@@ -1,25 +1,24 @@
-//! The simulated world's knowledge base: a PDDL state (from the problem's
-//! `:init`) with the formulas and effects the tree refers to, parsed once.
-//! The semantics are `btc_pddl::state`'s, the validator's.
+//! The simulated world's knowledge base: a PDDL state (from the world's
+//! initial facts) with the formulas and effects the tree refers to,
+//! compiled once. The semantics are `btc_pddl::state`'s, the validator's.
 
-use btc_pddl::ast::{Domain, Effect, Formula, Problem};
-use btc_pddl::state::{Changes, Env, Key, State, World};
-use btc_pddl::{lexer, parse, sexpr, DomainIndex, ProblemIndex};
+use btc_pddl::logic::{Atom, Effect, Formula, Name};
+use btc_pddl::state::{Changes, Cond, Eff, Key, State, World};
 use rustc_hash::FxHashMap;
 
-/// Index of a parsed formula or effect in a [`Kb`].
+/// Index of a compiled formula or effect in a [`Kb`].
 pub type FormulaId = u32;
 pub type EffectId = u32;
+/// Index of a condition compiled over port slots ([`Kb::condition`]).
+pub type ConditionId = u32;
 
 pub struct Kb<'w> {
-    pub world: World<'w>,
+    pub world: &'w World,
     pub state: State,
-    problem: &'w Problem,
-    formulas: Vec<Formula>,
-    /// For formulas that are ground literals (or a conjunction of them):
-    /// the atom keys, so checking them allocates nothing.
-    literals: Vec<Option<Vec<Literal>>>,
-    effects: Vec<Effect>,
+    formulas: Vec<Registered>,
+    effects: Vec<Eff>,
+    conditions: Vec<Cond>,
+    /// Formulas and effects by their text, so each is compiled once.
     formula_ids: FxHashMap<String, FormulaId>,
     effect_ids: FxHashMap<String, EffectId>,
     /// Goals added while running (a high-priority order).
@@ -28,23 +27,30 @@ pub struct Kb<'w> {
     goal_override: Option<FormulaId>,
 }
 
+/// A ground formula as written and as compiled; for one that is a ground
+/// literal (or a conjunction of them), its atom keys, so checking it
+/// allocates nothing.
+struct Registered {
+    formula: Formula,
+    cond: Cond,
+    literals: Option<Vec<Literal>>,
+}
+
+struct Literal {
+    key: Key,
+    positive: bool,
+    derived: bool,
+}
+
 impl<'w> Kb<'w> {
-    /// The KB of a problem: its initial state, derived atoms included.
-    pub fn new(
-        domain: &'w Domain,
-        dix: &'w DomainIndex,
-        problem: &'w Problem,
-        pix: &'w ProblemIndex,
-    ) -> Kb<'w> {
-        let world = World::new(domain, dix, pix);
-        let state = world.initial_state(problem);
+    /// The KB of a world: its initial state, derived atoms included.
+    pub fn new(world: &'w World) -> Kb<'w> {
         Kb {
             world,
-            state,
-            problem,
+            state: world.initial_state(),
             formulas: Vec::new(),
-            literals: Vec::new(),
             effects: Vec::new(),
+            conditions: Vec::new(),
             formula_ids: FxHashMap::default(),
             effect_ids: FxHashMap::default(),
             extra_goals: Vec::new(),
@@ -52,38 +58,25 @@ impl<'w> Kb<'w> {
         }
     }
 
-    /// The problem the KB was made from.
-    pub fn problem(&self) -> &'w Problem {
-        self.problem
+    /// A registered formula, as written.
+    pub fn formula_of(&self, f: FormulaId) -> &Formula {
+        &self.formulas[f as usize].formula
     }
 
-    /// A parsed formula (from [`Kb::formula`]).
-    pub fn formula_ast(&self, f: FormulaId) -> &Formula {
-        &self.formulas[f as usize]
-    }
-
-    /// The text of a formula registered with [`Kb::formula`].
-    pub fn formula_text(&self, f: FormulaId) -> Option<&str> {
-        self.formula_ids
-            .iter()
-            .find(|(_, &id)| id == f)
-            .map(|(t, _)| t.as_str())
-    }
-
-    /// The goals added while running, as their texts, in the order added.
-    pub fn extra_goal_texts(&self) -> Vec<String> {
+    /// The goals added while running, in the order added.
+    pub fn extra_goals(&self) -> Vec<Formula> {
         self.extra_goals
             .iter()
-            .filter_map(|&f| self.formula_text(f).map(str::to_owned))
+            .map(|&f| self.formula_of(f).clone())
             .collect()
     }
 
-    /// The goals added while running that do not hold, as their texts.
-    pub fn unmet_extra_goals(&self) -> Vec<String> {
+    /// The goals added while running that do not hold.
+    pub fn unmet_extra_goals(&self) -> Vec<Formula> {
         self.extra_goals
             .iter()
             .filter(|&&f| !self.holds(f))
-            .filter_map(|&f| self.formula_text(f).map(str::to_owned))
+            .map(|&f| self.formula_of(f).clone())
             .collect()
     }
 
@@ -92,83 +85,50 @@ impl<'w> Kb<'w> {
         self.goal_override = Some(f);
     }
 
-    fn sexp(text: &str) -> Result<sexpr::Sexp, String> {
-        let (tokens, diags) = lexer::lex(text, 0);
-        if let Some(d) = diags.first() {
-            return Err(d.message.clone());
-        }
-        let (mut forest, diags) = sexpr::build(tokens);
-        if let Some(d) = diags.first() {
-            return Err(d.message.clone());
-        }
-        if forest.len() != 1 {
-            return Err(format!(
-                "expected one parenthesised PDDL expression, found {}",
-                forest.len()
-            ));
-        }
-        Ok(forest.remove(0))
-    }
-
-    /// Parses and checks a ground PDDL condition, e.g. `(on p bin1)`.
-    pub fn formula(&mut self, text: &str) -> Result<FormulaId, String> {
-        if let Some(&id) = self.formula_ids.get(text) {
+    /// Compiles a ground condition, e.g. `(on p bin1)`, against the world.
+    pub fn formula(&mut self, f: &Formula) -> Result<FormulaId, String> {
+        let text = f.to_string();
+        if let Some(&id) = self.formula_ids.get(&text) {
             return Ok(id);
         }
-        let s = Self::sexp(text)?;
-        let (f, diags) = parse::formula_of(&s);
-        if let Some(d) = diags.first() {
-            return Err(d.message.clone());
-        }
-        let f = f.ok_or_else(|| "not a PDDL condition".to_owned())?;
-        let diags = btc_pddl::check::check_formula_in(
-            self.world.domain,
-            self.world.dix,
-            Some(self.world.pix),
-            &f,
-            &[],
-        );
-        if let Some(d) = diags.iter().find(|d| d.is_error()) {
-            return Err(d.message.clone());
-        }
+        let cond = self.world.compile(f, &[])?;
         let id = self.formulas.len() as FormulaId;
         let mut lits = Vec::new();
-        let lits = self.literals_of(&f, true, &mut lits).then_some(lits);
-        self.literals.push(lits);
-        self.formulas.push(f);
-        self.formula_ids.insert(text.to_owned(), id);
+        let literals = self.literals_of(&cond, true, &mut lits).then_some(lits);
+        self.formulas.push(Registered {
+            formula: f.clone(),
+            cond,
+            literals,
+        });
+        self.formula_ids.insert(text, id);
         Ok(id)
     }
 
-    /// Parses and checks a ground PDDL effect, e.g. `(and (a) (not (b)))`.
-    pub fn effect(&mut self, text: &str) -> Result<EffectId, String> {
-        if let Some(&id) = self.effect_ids.get(text) {
+    /// Compiles a ground effect, e.g. `(and (a) (not (b)))`.
+    pub fn effect(&mut self, e: &Effect) -> Result<EffectId, String> {
+        let text = e.to_string();
+        if let Some(&id) = self.effect_ids.get(&text) {
             return Ok(id);
         }
-        let s = Self::sexp(text)?;
-        let (e, diags) = parse::effect_of(&s);
-        if let Some(d) = diags.first() {
-            return Err(d.message.clone());
-        }
-        let e = e.ok_or_else(|| "not a PDDL effect".to_owned())?;
-        let diags = btc_pddl::check::check_effect_in(
-            self.world.domain,
-            self.world.dix,
-            Some(self.world.pix),
-            &e,
-            &[],
-        );
-        if let Some(d) = diags.iter().find(|d| d.is_error()) {
-            return Err(d.message.clone());
-        }
+        let eff = self.world.compile_effect(e, &[])?;
         let id = self.effects.len() as EffectId;
-        self.effects.push(e);
-        self.effect_ids.insert(text.to_owned(), id);
+        self.effects.push(eff);
+        self.effect_ids.insert(text, id);
         Ok(id)
+    }
+
+    /// Compiles a condition over port variables: at tick time it is
+    /// evaluated with the ports' objects in `ports`' order
+    /// ([`Kb::holds_with`]).
+    pub fn condition(&mut self, f: &Formula, ports: &[Name]) -> Result<ConditionId, String> {
+        let c = self.world.compile(f, ports)?;
+        self.conditions.push(c);
+        Ok(self.conditions.len() as ConditionId - 1)
     }
 
     pub fn holds(&self, f: FormulaId) -> bool {
-        if let Some(lits) = &self.literals[f as usize] {
+        let r = &self.formulas[f as usize];
+        if let Some(lits) = &r.literals {
             return lits.iter().all(|l| {
                 let set = if l.derived {
                     &self.state.derived
@@ -178,57 +138,73 @@ impl<'w> Kb<'w> {
                 set.contains(&l.key) == l.positive
             });
         }
-        self.world.holds(
-            &self.state,
-            &self.formulas[f as usize],
-            &mut Env::new(),
-            None,
-        )
+        self.world
+            .holds(&self.state, &r.cond, &mut Vec::new(), None)
     }
 
-    /// Collects `f` as ground literals; false when it is anything else.
-    fn literals_of(&self, f: &Formula, positive: bool, out: &mut Vec<Literal>) -> bool {
-        match f {
-            Formula::Atom { atom } => {
-                let Some(sig) = self.world.dix.predicates.get(atom.pred.as_str()) else {
-                    return false;
-                };
-                let Some(key) = self.world.atom_key(atom, &Env::new()) else {
-                    return false;
-                };
+    /// Whether condition `c` holds with its ports bound to `objects`.
+    pub fn holds_with(&self, c: ConditionId, objects: &[u32]) -> bool {
+        let mut b = objects.to_vec();
+        self.world
+            .holds(&self.state, &self.conditions[c as usize], &mut b, None)
+    }
+
+    /// Why condition `c` does not hold with its ports bound to `objects`.
+    pub fn why_not_with(&self, c: ConditionId, objects: &[u32]) -> String {
+        let mut b = objects.to_vec();
+        self.world
+            .why_not(&self.state, &self.conditions[c as usize], &mut b, None)
+            .0
+    }
+
+    /// Collects `c` as ground literals; false when it is anything else.
+    fn literals_of(&self, c: &Cond, positive: bool, out: &mut Vec<Literal>) -> bool {
+        match c {
+            Cond::Atom {
+                pred,
+                derived,
+                args,
+            } => {
+                let mut key = Vec::with_capacity(args.len() + 1);
+                key.push(*pred);
+                for a in args.iter() {
+                    match a {
+                        btc_pddl::state::CTerm::Obj(o) => key.push(*o),
+                        btc_pddl::state::CTerm::Slot(_) => return false,
+                    }
+                }
                 out.push(Literal {
-                    key,
+                    key: key.into_boxed_slice(),
                     positive,
-                    derived: self.world.is_derived(sig.index as u32),
+                    derived: *derived,
                 });
                 true
             }
-            Formula::Not { formula, .. } if positive => self.literals_of(formula, false, out),
-            Formula::And { parts, .. } if positive => {
-                parts.iter().all(|p| self.literals_of(p, true, out))
-            }
+            Cond::Not(x) if positive => self.literals_of(x, false, out),
+            Cond::And(ps) if positive => ps.iter().all(|p| self.literals_of(p, true, out)),
             _ => false,
         }
     }
 
     /// Why `f` does not hold, in the user's terms.
     pub fn why_not(&self, f: FormulaId) -> String {
-        let (why, _) = self.world.why_not(
-            &self.state,
-            &self.formulas[f as usize],
-            &mut Env::new(),
-            None,
-        );
-        why
+        self.world
+            .why_not(
+                &self.state,
+                &self.formulas[f as usize].cond,
+                &mut Vec::new(),
+                None,
+            )
+            .0
     }
 
     /// The changes an effect would make now.
     pub fn changes(&self, e: EffectId) -> Changes {
         let mut c = Changes::default();
-        self.world.collect_effect(
+        self.world.collect(
             &self.state,
             &self.effects[e as usize],
-            &mut Env::new(),
+            &mut Vec::new(),
             None,
             &mut c,
         );
@@ -252,18 +228,20 @@ impl<'w> Kb<'w> {
         );
     }
 
-    /// The key of a ground atom written as text, e.g. `(is_enabled r1)`.
-    pub fn atom_key(&mut self, text: &str) -> Result<Key, String> {
-        let e = self.effect(text)?;
-        let c = self.changes(e);
-        match (c.add.as_slice(), c.delete.as_slice()) {
-            ([k], []) => Ok(k.clone()),
-            _ => Err(format!("`{text}` is not one positive ground atom")),
+    /// The key of a ground atom, e.g. `(is_enabled r1)`.
+    pub fn atom_key(&self, a: &Atom) -> Result<Key, String> {
+        let k = self.world.atom_key(a)?;
+        if self.world.is_derived(k[0]) {
+            return Err(format!(
+                "`{}` is a derived predicate: only the facts it is derived from change",
+                a.pred
+            ));
         }
+        Ok(k)
     }
 
     pub fn object(&self, name: &str) -> Option<u32> {
-        self.world.pix.objects.get(name).map(|o| o.id)
+        self.world.object_id(name)
     }
 
     /// Every fact that mentions object `o`.
@@ -315,9 +293,10 @@ impl<'w> Kb<'w> {
             if !self.holds(g) {
                 return (false, Some(self.why_not(g)));
             }
-        } else if let Some(g) = &self.problem.goal {
-            if !self.world.holds(&self.state, g, &mut Env::new(), None) {
-                let (why, _) = self.world.why_not(&self.state, g, &mut Env::new(), None);
+        } else if let Some(g) = self.world.goal() {
+            let mut b = Vec::new();
+            if !self.world.holds(&self.state, g, &mut b, None) {
+                let (why, _) = self.world.why_not(&self.state, g, &mut b, None);
                 return (false, Some(why));
             }
         }
@@ -328,46 +307,20 @@ impl<'w> Kb<'w> {
         }
         (true, None)
     }
-}
 
-struct Literal {
-    key: Key,
-    positive: bool,
-    derived: bool,
-}
-
-/// Fills `?var` occurrences in PDDL text from `value` (token-aware: `?a`
-/// does not touch `?ab`); unknown variables stay.
-pub fn substitute(text: &str, value: impl Fn(&str) -> Option<String>) -> String {
-    let mut out = String::with_capacity(text.len() + 16);
-    let mut rest = text;
-    while let Some(q) = rest.find('?') {
-        out.push_str(&rest[..q]);
-        let after = &rest[q + 1..];
-        let len = after
-            .find(|c: char| !(c.is_alphanumeric() || c == '_' || c == '-'))
-            .unwrap_or(after.len());
-        let var = &after[..len];
-        match value(&var.to_lowercase()) {
-            Some(v) if !var.is_empty() => out.push_str(&v),
-            _ => {
-                out.push('?');
-                out.push_str(var);
-            }
-        }
-        rest = &after[len..];
+    /// Whether the world has a goal at all (its own or one set or added).
+    pub fn has_goal(&self) -> bool {
+        self.goal_override.is_some() || self.world.goal().is_some() || !self.extra_goals.is_empty()
     }
-    out.push_str(rest);
-    out
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use btc_pddl::logic::decode;
     use btc_pddl::pipeline;
 
-    #[test]
-    fn ground_literals_take_the_fast_path_with_the_same_answers() {
+    fn world() -> World {
         let du = pipeline::domain_unit_from(include_str!("../tests/fixtures/flags/domain.pddl"), 0);
         let pu = pipeline::problem_unit_from(
             include_str!("../tests/fixtures/flags/problem.pddl"),
@@ -375,12 +328,19 @@ mod tests {
             du.domain.as_ref(),
             &du.index,
         );
-        let mut kb = Kb::new(
+        World::of_checked(
             du.domain.as_ref().unwrap(),
             &du.index,
             pu.problem.as_ref().unwrap(),
             &pu.index,
-        );
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn ground_literals_take_the_fast_path_with_the_same_answers() {
+        let w = world();
+        let mut kb = Kb::new(&w);
         for (text, fast, expect) in [
             ("(at r1 bin1)", true, true),
             ("(and (at r1 bin1) (not (go)))", true, true),
@@ -388,21 +348,34 @@ mod tests {
             ("(or (go) (at r1 bin1))", false, true),
             ("(not (and (go) (done)))", false, true),
         ] {
-            let f = kb.formula(text).unwrap();
-            assert_eq!(kb.literals[f as usize].is_some(), fast, "{text}");
+            let f = kb.formula(&decode::formula(text).unwrap()).unwrap();
+            assert_eq!(kb.formulas[f as usize].literals.is_some(), fast, "{text}");
             assert_eq!(kb.holds(f), expect, "{text}");
-            let slow = kb
-                .world
-                .holds(&kb.state, &kb.formulas[f as usize], &mut Env::new(), None);
+            let slow = kb.world.holds(
+                &kb.state,
+                &kb.formulas[f as usize].cond,
+                &mut Vec::new(),
+                None,
+            );
             assert_eq!(slow, expect, "{text}");
         }
     }
 
     #[test]
-    fn substitution_is_token_aware() {
-        let s = substitute("(and (at ?r ?rb) (ok ?r))", |v| {
-            (v == "r").then(|| "robot1".to_owned())
-        });
-        assert_eq!(s, "(and (at robot1 ?rb) (ok robot1))");
+    fn conditions_over_ports_are_evaluated_with_their_objects() {
+        let w = world();
+        let mut kb = Kb::new(&w);
+        let ports = [btc_pddl::logic::name("r"), btc_pddl::logic::name("b")];
+        let c = kb
+            .condition(&decode::formula("(at ?r ?b)").unwrap(), &ports)
+            .unwrap();
+        let (r1, bin1, bin2) = (
+            kb.object("r1").unwrap(),
+            kb.object("bin1").unwrap(),
+            kb.object("bin2").unwrap(),
+        );
+        assert!(kb.holds_with(c, &[r1, bin1]));
+        assert!(!kb.holds_with(c, &[r1, bin2]));
+        assert_eq!(kb.why_not_with(c, &[r1, bin2]), "`(at r1 bin2)` is false");
     }
 }

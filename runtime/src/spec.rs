@@ -64,11 +64,25 @@ pub struct TreeDoc {
     pub models: Vec<NodeModel>,
     /// The compiled plan's steps (preconditions, effects) when known.
     pub steps: Vec<StepInfo>,
+    /// The domain's actions, for `KbStep`s of a tree file without a step
+    /// table (BT.CPP XML): their conditions are the action's, grounded.
+    pub actions: Vec<btc_pddl::logic::ActionSchema>,
 }
 
 impl TreeDoc {
     pub fn tree(&self, id: &str) -> Option<&SNode> {
         self.trees.iter().find(|(t, _)| t == id).map(|(_, n)| n)
+    }
+
+    /// The document with the domain's actions, for a tree file whose
+    /// `KbStep`s come without a step table.
+    pub fn with_actions(mut self, domain: &btc_pddl::Domain) -> TreeDoc {
+        self.actions = domain
+            .actions
+            .iter()
+            .map(btc_pddl::logic::ActionSchema::from_ast)
+            .collect();
+        self
     }
 
     pub fn model(&self, id: &str) -> Option<&NodeModel> {
@@ -84,6 +98,7 @@ impl TreeDoc {
             trees,
             models: ir.nodes.clone(),
             steps: ir.steps.clone(),
+            actions: Vec::new(),
         }
     }
 

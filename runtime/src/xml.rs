@@ -245,6 +245,8 @@ pub fn parse(text: &str) -> Result<TreeDoc, LoadError> {
     let mut stack: Vec<SNode> = Vec::new();
     let mut tree_root: Option<SNode> = None;
     let mut saw_root = false;
+    // IDs seen so far (a set: a list made 100,000 trees quadratic).
+    let mut tree_ids = std::collections::HashSet::new();
     loop {
         let at = r.buffer_position() as usize;
         let ev = r.read_event().map_err(|e| {
@@ -288,7 +290,7 @@ pub fn parse(text: &str) -> Result<TreeDoc, LoadError> {
                 Place::Root => match e.name.as_str() {
                     "BehaviorTree" => {
                         let id = e.get("ID").unwrap_or("MainTree").to_owned();
-                        if doc.tree(&id).is_some() {
+                        if !tree_ids.insert(id.clone()) {
                             return Err(syntax(format!("the tree `{id}` is defined twice"), at));
                         }
                         if empty {

@@ -53,17 +53,15 @@ fn corpus_plans_run_to_their_goal() {
             let ir = compile(&db, job)
                 .clone()
                 .unwrap_or_else(|e| panic!("{}: {e:#?}", plan.display()));
-            let w = JobWorld::of(&db, job).unwrap();
+            let jw = JobWorld::of(&db, job).unwrap();
+            let w = jw.world().unwrap();
             let what = plan.display().to_string();
             let xml_text = btc_emit::btcpp::emit(&ir, false);
             let mut traces = Vec::new();
-            for doc in [TreeDoc::from_ir(&ir), xml::parse(&xml_text).unwrap()] {
-                let mut e = Engine::build(
-                    &doc,
-                    Some(btc_runtime::Kb::new(w.domain, w.dix, w.problem, w.pix)),
-                    traced(),
-                )
-                .unwrap_or_else(|e| panic!("{what}: {e}"));
+            let from_xml = xml::parse(&xml_text).unwrap().with_actions(jw.domain);
+            for doc in [TreeDoc::from_ir(&ir), from_xml] {
+                let mut e = Engine::build(&doc, Some(btc_runtime::Kb::new(&w)), traced())
+                    .unwrap_or_else(|e| panic!("{what}: {e}"));
                 let s = e.run(1_000_000, |_| {});
                 let sum = e.summary(s);
                 assert_eq!(s, Status::Success, "{what}: {:#?}", sum.records);

@@ -2,7 +2,7 @@
 //! written as BT.CPP XML and loaded back runs exactly like its IR.
 
 mod common;
-use btc_runtime::{xml, Status, TreeDoc};
+use btc_runtime::{Status, TreeDoc};
 use common::*;
 
 #[test]
@@ -23,7 +23,7 @@ fn every_example_reaches_its_goal() {
         assert_eq!(sum.goal_reached, Some(true), "{name}");
         // The goal's facts are in the final KB, read directly.
         let kb = e.kb.as_ref().unwrap();
-        let goal = w.problem.goal.as_ref().unwrap();
+        let goal = w.goal().unwrap();
         assert!(
             kb.world.holds(&kb.state, goal, &mut Vec::new(), None),
             "{name}"
@@ -63,7 +63,7 @@ fn btcpp_xml_runs_exactly_like_its_ir() {
             let text = btc_emit::btcpp::emit(&ex.ir, inline);
             // The XML carries the steps' effects; their conditions come
             // from the domain's actions, as `btc run --tree` does.
-            let from_xml = xml::parse(&text).unwrap_or_else(|e| panic!("{name}: {e}"));
+            let from_xml = ex.xml(&text);
             assert!(from_xml.steps.is_empty());
             let mut a = ex.engine(&w, &from_ir, traced());
             let mut b = ex.engine(&w, &from_xml, traced());
@@ -102,7 +102,7 @@ fn xml_steps_check_the_domain_preconditions_like_the_ir() {
         std::fs::read_to_string(root().join("examples/ariac/faults/faulty_part.toml")).unwrap();
     let sc = btc_runtime::Scenario::parse(&sc_text).unwrap();
     let mut runs = Vec::new();
-    for doc in [TreeDoc::from_ir(&ex.ir), xml::parse(&text).unwrap()] {
+    for doc in [TreeDoc::from_ir(&ex.ir), ex.xml(&text)] {
         let mut e = ex.engine(&w, &doc, traced());
         e.add_faults(&sc).unwrap();
         assert_eq!(e.run(1000, |_| {}), Status::Failure);

@@ -126,7 +126,12 @@ fn a_malfunction_is_repaired_after_its_duration() {
     // The run failed at tick 2; ticking on past the duration brings the
     // retracted fact back.
     let kb = e.kb.as_mut().unwrap();
-    let key = kb.atom_key("(is_enabled floor_robot)").unwrap();
+    let key = kb
+        .atom_key(&btc_pddl::logic::Atom::ground(
+            "is_enabled",
+            &["floor_robot"],
+        ))
+        .unwrap();
     assert!(!kb.state.facts.contains(&key));
     for _ in 0..6 {
         e.tick_once();

@@ -4,15 +4,16 @@
 //! sources (`controls/*.cpp`, `decorators/*.cpp`).
 
 mod common;
-use btc_pddl::pipeline::{self, DomainUnit, ProblemUnit};
+use btc_pddl::logic::decode;
+use btc_pddl::pipeline;
+use btc_pddl::state::World;
 use btc_runtime::engine::TraceItem;
 use btc_runtime::{xml, Engine, Kb, Options, Status, Value};
 use common::fixture;
 use Status::*;
 
 struct Flags {
-    du: DomainUnit,
-    pu: ProblemUnit,
+    world: World,
 }
 
 fn flags() -> Flags {
@@ -24,18 +25,20 @@ fn flags() -> Flags {
         &du.index,
     );
     assert!(du.diagnostics.is_empty() && pu.diagnostics.is_empty());
-    Flags { du, pu }
+    let world = World::of_checked(
+        du.domain.as_ref().unwrap(),
+        &du.index,
+        pu.problem.as_ref().unwrap(),
+        &pu.index,
+    )
+    .unwrap();
+    Flags { world }
 }
 
 fn engine<'a>(w: &'a Flags, tree: &str, ticks_per_action: u32) -> Engine<'a> {
     let doc = xml::parse(&fixture(&format!("semantics/{tree}.xml")))
         .unwrap_or_else(|e| panic!("{tree}: {e}"));
-    let kb = Kb::new(
-        w.du.domain.as_ref().unwrap(),
-        &w.du.index,
-        w.pu.problem.as_ref().unwrap(),
-        &w.pu.index,
-    );
+    let kb = Kb::new(&w.world);
     let opts = Options {
         ticks_per_action,
         ms_per_tick: 10,
@@ -51,13 +54,13 @@ fn set(e: &mut Engine, fact: &str, on: bool) {
     } else {
         format!("(not {fact})")
     };
-    let id = kb.effect(&text).unwrap();
+    let id = kb.effect(&decode::effect(&text).unwrap()).unwrap();
     kb.apply(id);
 }
 
 fn holds(e: &mut Engine, fact: &str) -> bool {
     let kb = e.kb.as_mut().unwrap();
-    let f = kb.formula(fact).unwrap();
+    let f = kb.formula(&decode::formula(fact).unwrap()).unwrap();
     kb.holds(f)
 }
 

@@ -106,7 +106,8 @@ pub fn plan_validation(db: &dyn Db, job: CompileJob) -> Vec<Diagnostic> {
         let v = btc_pddl::validate::validate_plan(
             domain, prob, &cd.index, &cp.index, &tp.plan, &tp.steps,
         );
-        Some(v.diagnostics)
+        // A world the logic layer cannot build is reported by the checks.
+        v.ok().map(|v| v.diagnostics)
     };
     let Some(mut diags) = valid_for(p) else {
         return Vec::new();

@@ -27,7 +27,11 @@ impl Loaded {
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum ReadFailure {
     NotFound,
-    /// It exists but cannot be read (permissions, a folder, a device...).
+    /// A folder, a device: nothing that has a file's contents.
+    NotAFile {
+        reason: String,
+    },
+    /// It exists but cannot be read (permissions, too large for the reader...).
     Unreadable {
         reason: String,
     },
@@ -37,7 +41,9 @@ impl fmt::Display for ReadFailure {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             ReadFailure::NotFound => f.write_str("no such file"),
-            ReadFailure::Unreadable { reason } => f.write_str(reason),
+            ReadFailure::NotAFile { reason } | ReadFailure::Unreadable { reason } => {
+                f.write_str(reason)
+            }
         }
     }
 }

@@ -37,14 +37,16 @@ pub fn decode_diagnostic(id: FileId, problem: &DecodeProblem) -> Diagnostic {
             "this file starts with a UTF-16 byte-order mark but is not valid UTF-16",
         )
         .with_hint("save the file as UTF-8"),
-        DecodeProblem::TooLarge { bytes } => Diagnostic::error(
-            codes::FILE_TOO_LARGE,
-            Span::new(id, 0, 0),
-            format!(
-                "this file has {bytes} bytes; btc reads files of at most {} bytes",
-                btc_pddl::source::MAX_FILE_BYTES
-            ),
-        ),
+        DecodeProblem::TooLarge { bytes } => {
+            let max = btc_pddl::source::MAX_FILE_BYTES;
+            // A stream that went on past the limit has no known size.
+            let message = if bytes == max + 1 {
+                format!("this input goes on past {max} bytes, the most btc reads")
+            } else {
+                format!("this file has {bytes} bytes; btc reads files of at most {max} bytes")
+            };
+            Diagnostic::error(codes::FILE_TOO_LARGE, Span::new(id, 0, 0), message)
+        }
     }
 }
 
@@ -63,13 +65,17 @@ fn unreadable_references(db: &dyn Db, rules: SourceFile) -> Vec<Diagnostic> {
     let unread = db.workspace().unread(db);
     references(db, rules)
         .iter()
-        .filter_map(|r| match unread.get(&r.path) {
-            Some(ReadFailure::Unreadable { reason }) => Some(Diagnostic::error(
-                codes::FILE_UNREADABLE,
+        .filter_map(|r| {
+            let (code, reason) = match unread.get(&r.path)? {
+                ReadFailure::NotFound => return None,
+                ReadFailure::NotAFile { reason } => (codes::FILE_NOT_REGULAR, reason),
+                ReadFailure::Unreadable { reason } => (codes::FILE_UNREADABLE, reason),
+            };
+            Some(Diagnostic::error(
+                code,
                 r.span,
                 format!("cannot read the {} `{}`: {reason}", r.kind.noun(), r.path),
-            )),
-            _ => None,
+            ))
         })
         .collect()
 }

@@ -1067,7 +1067,7 @@ pub fn check_file(
         .iter()
         .filter(|i| matches!(i.item, Item::Domain { .. }))
         .collect();
-    if domains.is_empty() && !items.is_empty() {
+    if domains.is_empty() {
         diags.push(
             Diagnostic::error(
                 codes::R_NO_DOMAIN,

@@ -1,7 +1,7 @@
 //! Tokens of `.btrules` files. Comments are kept apart (the formatter puts
 //! them back); everything else goes to the parser.
 
-use btc_pddl::diagnostic::{codes, Diagnostic};
+use btc_pddl::diagnostic::{codes, Cap, Diagnostic};
 use btc_pddl::source::{FileId, Span};
 use std::fmt;
 
@@ -59,12 +59,55 @@ pub struct Lexed {
 const TWO_CHAR_PUNCTS: &[&str] = &["=>", "==", "!=", "::"];
 const ONE_CHAR_PUNCTS: &[&str] = &["(", ")", "{", "}", "[", "]", ",", ":", "=", "-"];
 
-fn is_ident_start(b: u8) -> bool {
-    b.is_ascii_alphabetic() || b == b'_'
+/// Names may hold any letters (as PDDL names may: `İs_enabled`).
+fn is_ident_start(c: char) -> bool {
+    c.is_alphabetic() || c == '_'
 }
 
-fn is_ident_rest(b: u8) -> bool {
-    b.is_ascii_alphanumeric() || b == b'_' || b == b'-'
+fn is_ident_rest(c: char) -> bool {
+    c.is_alphanumeric() || c == '_' || c == '-'
+}
+
+/// The char at byte `i` (a char boundary) and its length.
+fn char_at(text: &str, i: usize) -> Option<char> {
+    text[i..].chars().next()
+}
+
+/// The end of the name that starts at `i` (after its first char).
+fn ident_end(text: &str, mut j: usize) -> usize {
+    let b = text.as_bytes();
+    while j < b.len() {
+        if b[j].is_ascii() {
+            if !is_ident_rest(b[j] as char) {
+                break;
+            }
+            j += 1;
+        } else {
+            match char_at(text, j) {
+                Some(c) if is_ident_rest(c) => j += c.len_utf8(),
+                _ => break,
+            }
+        }
+    }
+    j
+}
+
+/// Whether the text at `i` starts a token (or whitespace, or a comment):
+/// where a run of characters that start nothing ends.
+fn starts_something(text: &str, i: usize) -> bool {
+    let b = text.as_bytes();
+    let c = b[i];
+    c.is_ascii_whitespace()
+        || c == b'"'
+        || c == b'/' && matches!(b.get(i + 1), Some(b'/' | b'*'))
+        || c == b'?' && char_at(text, i + 1).is_some_and(is_ident_start)
+        || c.is_ascii_digit()
+        || (c == b'-' && b.get(i + 1).is_some_and(u8::is_ascii_digit))
+        || char_at(text, i).is_some_and(is_ident_start)
+        || TWO_CHAR_PUNCTS
+            .iter()
+            .any(|p| b[i..].starts_with(p.as_bytes()))
+        || ONE_CHAR_PUNCTS.iter().any(|p| p.as_bytes()[0] == c)
 }
 
 /// Splits a rules file into tokens and comments. Hand-written (one pass
@@ -81,11 +124,18 @@ pub fn lex(text: &str, file: FileId) -> Lexed {
     let mut i = 0;
     // End of the last code token, to tell trailing comments from own-line ones.
     let mut last_code_end: Option<usize> = None;
+    // Start of the current line, kept as the lexer goes (searching back for
+    // it per comment would be quadratic on one long line).
+    let mut line_start = 0;
+    let mut errors = Cap::new(codes::R_SYNTAX, "lexical error");
     let span = |s: usize, e: usize| Span::new(file, s, e);
     while i < b.len() {
         let c = b[i];
         if c.is_ascii_whitespace() {
             i += 1;
+            if c == b'\n' {
+                line_start = i;
+            }
             continue;
         }
         let start = i;
@@ -96,8 +146,10 @@ pub fn lex(text: &str, file: FileId) -> Lexed {
             } else {
                 text[i + 2..].find("*/").map_or(b.len(), |k| i + 2 + k + 2)
             };
-            let line_start = text[..start].rfind('\n').map_or(0, |k| k + 1);
             let trailing = last_code_end.is_some_and(|e| e >= line_start);
+            if let Some(k) = text[start..end].rfind('\n') {
+                line_start = start + k + 1;
+            }
             let body = &text[start..end];
             let body = if body.starts_with("//") {
                 body.trim_end()
@@ -132,7 +184,8 @@ pub fn lex(text: &str, file: FileId) -> Lexed {
                 Tok::Str(text[start + 1..j].to_owned())
             } else {
                 i = j;
-                out.diagnostics.push(
+                errors.push(
+                    &mut out.diagnostics,
                     Diagnostic::error(
                         codes::R_SYNTAX,
                         span(start, j),
@@ -142,11 +195,9 @@ pub fn lex(text: &str, file: FileId) -> Lexed {
                 );
                 Tok::Str(text[start + 1..j].to_owned())
             }
-        } else if c == b'?' && b.get(i + 1).copied().is_some_and(is_ident_start) {
-            let mut j = i + 2;
-            while j < b.len() && is_ident_rest(b[j]) {
-                j += 1;
-            }
+        } else if c == b'?' && char_at(text, i + 1).is_some_and(is_ident_start) {
+            let first = char_at(text, i + 1).map_or(1, char::len_utf8);
+            let j = ident_end(text, i + 1 + first);
             i = j;
             Tok::Var(text[start + 1..j].to_owned())
         } else if c.is_ascii_digit() || (c == b'-' && b.get(i + 1).is_some_and(u8::is_ascii_digit))
@@ -170,11 +221,8 @@ pub fn lex(text: &str, file: FileId) -> Lexed {
                     Err(_) => Tok::Error('0'),
                 },
             }
-        } else if is_ident_start(c) {
-            let mut j = i + 1;
-            while j < b.len() && is_ident_rest(b[j]) {
-                j += 1;
-            }
+        } else if let Some(first) = char_at(text, i).filter(|c| is_ident_start(*c)) {
+            let j = ident_end(text, i + first.len_utf8());
             i = j;
             Tok::Ident(text[start..j].to_owned())
         } else if let Some(p) = TWO_CHAR_PUNCTS
@@ -187,13 +235,27 @@ pub fn lex(text: &str, file: FileId) -> Lexed {
             i += 1;
             Tok::Punct(p)
         } else {
-            let ch = text[i..].chars().next().expect("not at the end");
+            // One token and one diagnostic for a whole run of characters
+            // that start nothing (10 KB of NUL bytes is one problem).
+            let ch = char_at(text, i).expect("not at the end");
             i += ch.len_utf8();
-            out.diagnostics.push(Diagnostic::error(
-                codes::R_SYNTAX,
-                span(start, i),
-                format!("`{ch}` cannot start anything here"),
-            ));
+            let mut more = 0usize;
+            while i < b.len() && !starts_something(text, i) {
+                i += char_at(text, i).map_or(1, char::len_utf8);
+                more += 1;
+            }
+            let shown = ch.escape_debug();
+            let message = match more {
+                0 => format!("`{shown}` cannot start anything here"),
+                n => format!(
+                    "`{shown}` and the {n} character{} after it cannot start anything here",
+                    if n == 1 { "" } else { "s" }
+                ),
+            };
+            errors.push(
+                &mut out.diagnostics,
+                Diagnostic::error(codes::R_SYNTAX, span(start, i), message),
+            );
             Tok::Error(ch)
         };
         if !matches!(tok, Tok::Error(_)) {
@@ -201,6 +263,7 @@ pub fn lex(text: &str, file: FileId) -> Lexed {
         }
         out.tokens.push((tok, span(start, i)));
     }
+    errors.finish(&mut out.diagnostics, span(b.len(), b.len()));
     out
 }
 

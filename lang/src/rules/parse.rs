@@ -13,8 +13,82 @@ use btc_pddl::source::{FileId, Span};
 use chumsky::input::ValueInput;
 use chumsky::prelude::*;
 
-/// Deepest nesting of brackets inside one item.
+/// Deepest nesting inside one item: brackets, and decorators chained on one
+/// template (`inverter retry(3) X()` is three levels), which the parser and
+/// every pass after it recurse through.
 pub const MAX_ITEM_DEPTH: usize = 64;
+
+/// Words that make a decorator of the template after them.
+const DECORATORS: &[&str] = &["inverter", "force_success", "force_failure"];
+const DECORATORS_WITH_ARGUMENT: &[&str] = &["retry", "repeat", "timeout"];
+const CONTROLS: &[&str] = &[
+    "sequence",
+    "reactive_sequence",
+    "fallback",
+    "reactive_fallback",
+    "parallel",
+];
+
+/// How deep an item nests as the parser will recurse: each bracket is a
+/// level, and so is each decorator of a chain, until the template the
+/// chain decorates ends. Computed on the tokens, before parsing, so that
+/// the limit holds for the parser too.
+#[derive(Default)]
+struct Nesting {
+    /// Per open bracket: its kind, and the template depth and chain
+    /// outside it.
+    open: Vec<(&'static str, usize, usize)>,
+    /// Depth of the template being read at the current level.
+    base: usize,
+    /// Decorators chained on it so far.
+    chain: usize,
+}
+
+impl Nesting {
+    /// The depth after `tokens[i]`.
+    fn step(&mut self, tokens: &[(Tok, Span)], i: usize) -> usize {
+        let in_block = matches!(self.open.last(), None | Some(("{", _, _)));
+        match &tokens[i].0 {
+            Tok::Punct(p @ ("(" | "{" | "[")) => {
+                let outside = self.base + self.chain;
+                self.open.push((p, self.base, self.chain));
+                self.base = outside + 1;
+                self.chain = 0;
+            }
+            Tok::Punct(")" | "}" | "]") => {
+                let closed = self.open.pop();
+                self.base = closed.map_or(0, |(_, b, _)| b);
+                // A block ends the template that owns it (and its chain);
+                // the parenthesis of `retry(3)` leaves the chain going.
+                self.chain = match closed {
+                    Some(("(", _, chain)) => chain,
+                    _ => 0,
+                };
+            }
+            Tok::Ident(w) if in_block => {
+                let next = tokens.get(i + 1).map(|t| &t.0);
+                let bare = DECORATORS.contains(&w.as_str())
+                    && matches!(next, Some(Tok::Ident(_) | Tok::Str(_)));
+                let with_arg = DECORATORS_WITH_ARGUMENT.contains(&w.as_str())
+                    && matches!(next, Some(Tok::Punct("(")));
+                if bare || with_arg {
+                    self.chain += 1;
+                } else if CONTROLS.contains(&w.as_str()) {
+                    // Its block (after `parallel(...)`'s arguments) nests
+                    // inside the chain.
+                } else if matches!(next, Some(Tok::Punct("("))) || matches!(w.as_str(), "steps") {
+                    // A call (or `steps`): the chain ends at this leaf,
+                    // after its own argument list.
+                    let depth = self.base + self.chain + 1;
+                    self.chain = 0;
+                    return depth;
+                }
+            }
+            _ => {}
+        }
+        self.base + self.chain
+    }
+}
 
 /// Words that start a top-level item.
 pub const ITEM_KEYWORDS: &[&str] = &[
@@ -220,7 +294,7 @@ fn parse_item(tokens: &[(Tok, Span)], offset: u32, file: FileId) -> (Item, Vec<D
     // Pre-pass: relative spans, PDDL groups read, nesting bounded.
     let mut input: Vec<(Tok, SimpleSpan)> = Vec::with_capacity(tokens.len());
     let is_condition = matches!(tokens.first(), Some((Tok::Ident(k), _)) if k == "condition");
-    let mut depth = 0usize;
+    let mut nesting = Nesting::default();
     let mut i = 0;
     while i < tokens.len() {
         let (t, span) = &tokens[i];
@@ -235,20 +309,21 @@ fn parse_item(tokens: &[(Tok, Span)], offset: u32, file: FileId) -> (Item, Vec<D
                 continue;
             }
         }
-        match t {
-            Tok::Punct("(" | "{" | "[") => {
-                depth += 1;
-                if depth > MAX_ITEM_DEPTH {
-                    diags.push(Diagnostic::error(
-                        codes::R_SYNTAX,
-                        Span::new(file, rel(*span, offset).start, rel(*span, offset).end),
-                        format!("brackets are nested more than {MAX_ITEM_DEPTH} levels deep"),
-                    ));
-                    return (Item::Error { span: whole }, diags);
-                }
-            }
-            Tok::Punct(")" | "}" | "]") => depth = depth.saturating_sub(1),
-            _ => {}
+        if nesting.step(tokens, i) > MAX_ITEM_DEPTH {
+            let what = if matches!(t, Tok::Punct(_)) {
+                "brackets"
+            } else {
+                "brackets and chained decorators"
+            };
+            diags.push(
+                Diagnostic::error(
+                    codes::R_TOO_DEEP,
+                    Span::new(file, rel(*span, offset).start, rel(*span, offset).end),
+                    format!("{what} are nested more than {MAX_ITEM_DEPTH} levels deep here"),
+                )
+                .with_hint("split the template into `tree`s that call each other"),
+            );
+            return (Item::Error { span: whole }, diags);
         }
         input.push((t.clone(), rel(*span, offset)));
         i += 1;
@@ -320,9 +395,19 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
     let count = int.try_map(|n, span| {
         u32::try_from(n).map_err(|_| Rich::custom(span, "expected a count from 0 to 4294967295"))
     });
+    // A bad escape or interpolation is reported, and the string still
+    // parses (as its raw text): failing here would let chumsky merge the
+    // error into "expected a string, found a string".
     let strlit = select! { Tok::Str(s) => s }
-        .try_map(move |raw, span: SimpleSpan| {
-            interpolate(&raw, file, span.start).map_err(|(msg, at)| Rich::custom(at, msg))
+        .validate(move |raw: String, e, emitter| {
+            let span: SimpleSpan = e.span();
+            interpolate(&raw, file, span.start).unwrap_or_else(|(msg, at)| {
+                emitter.emit(Rich::custom(at, msg));
+                StrLit {
+                    span: Span::new(file, span.start, span.end),
+                    parts: vec![StrPart::Text { text: raw }],
+                }
+            })
         })
         .labelled("a string");
 

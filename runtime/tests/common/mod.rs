@@ -5,6 +5,7 @@
 use btc_ir::TreeIr;
 use btc_lang::db::JobWorld;
 use btc_lang::db::{self, CompileJob, Database};
+use btc_pddl::state::World;
 use btc_runtime::{Engine, Options, TreeDoc};
 use std::path::{Path, PathBuf};
 
@@ -59,18 +60,25 @@ pub fn example(name: &str) -> Example {
 }
 
 impl Example {
-    pub fn world(&self) -> JobWorld<'_> {
+    pub fn job_world(&self) -> JobWorld<'_> {
         JobWorld::of(&self.db, self.job).expect("the example has a domain and a problem")
     }
 
+    /// The example's world, ready for a knowledge base.
+    pub fn world(&self) -> World {
+        self.job_world().world().unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// A BT.CPP XML tree of the example, with its domain's actions.
+    pub fn xml(&self, text: &str) -> TreeDoc {
+        btc_runtime::xml::parse(text)
+            .unwrap_or_else(|e| panic!("{e}"))
+            .with_actions(self.job_world().domain)
+    }
+
     /// An engine over the example's world for `doc`.
-    pub fn engine<'a>(&'a self, w: &'a JobWorld<'a>, doc: &TreeDoc, opts: Options) -> Engine<'a> {
-        Engine::build(
-            doc,
-            Some(btc_runtime::Kb::new(w.domain, w.dix, w.problem, w.pix)),
-            opts,
-        )
-        .unwrap_or_else(|e| panic!("{e}"))
+    pub fn engine<'a>(&self, w: &'a World, doc: &TreeDoc, opts: Options) -> Engine<'a> {
+        Engine::build(doc, Some(btc_runtime::Kb::new(w)), opts).unwrap_or_else(|e| panic!("{e}"))
     }
 }
 

@@ -1,0 +1,253 @@
+//! The writer. A regular file is replaced atomically: the new contents go
+//! to a temporary file in the target's folder, which takes the old file's
+//! mode and owner (or the umask's mode for a new file), is synced and
+//! renamed over the target. What a rename would damage is written in place
+//! instead: special files (`/dev/null`, `/dev/stdout`, a FIFO), files with
+//! several hard links, files whose owner btc cannot give the temporary
+//! file, and files in folders btc may not create files in. A symbolic link
+//! is followed: its target is written, the link stays.
+
+use crate::cleanup;
+use std::fs::{File, OpenOptions};
+use std::io::{self, BufWriter, Write};
+use std::os::unix::fs::{MetadataExt, OpenOptionsExt, PermissionsExt};
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+
+/// How deep a chain of symbolic links btc follows (as Linux does).
+const MAX_LINKS: usize = 40;
+
+/// The file a path names after following symbolic links; the path itself
+/// when it is not a link (or does not exist yet).
+pub fn resolve(path: &Path) -> io::Result<PathBuf> {
+    let mut p = path.to_path_buf();
+    for _ in 0..MAX_LINKS {
+        match std::fs::symlink_metadata(&p) {
+            Ok(m) if m.file_type().is_symlink() => {
+                let to = std::fs::read_link(&p)?;
+                p = match p.parent() {
+                    Some(dir) if to.is_relative() => dir.join(to),
+                    _ => to,
+                };
+            }
+            _ => return Ok(p),
+        }
+    }
+    Err(io::Error::other(format!(
+        "more than {MAX_LINKS} symbolic links lead from `{}`",
+        path.display()
+    )))
+}
+
+/// How a target is to be written.
+enum Plan {
+    /// Through a temporary file and a rename, with this mode and owner
+    /// (`None`: a new file, the umask's mode, btc's owner).
+    Atomic(Option<(u32, u32, u32)>),
+    /// Opened and overwritten where it is.
+    InPlace { truncate: bool },
+}
+
+fn plan(target: &Path) -> io::Result<Plan> {
+    match std::fs::metadata(target) {
+        Ok(m) if m.is_dir() => Err(io::Error::other("it is a folder")),
+        Ok(m) if !m.is_file() => Ok(Plan::InPlace { truncate: false }),
+        Ok(m) if m.nlink() > 1 => Ok(Plan::InPlace { truncate: true }),
+        Ok(m) => Ok(Plan::Atomic(Some((m.mode() & 0o7777, m.uid(), m.gid())))),
+        Err(e) if e.kind() == io::ErrorKind::NotFound => Ok(Plan::Atomic(None)),
+        Err(e) => Err(e),
+    }
+}
+
+/// Writes `bytes` to `path` (see the module's documentation for how).
+pub fn write(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    let target = resolve(path)?;
+    match plan(&target)? {
+        Plan::InPlace { truncate } => in_place(&target, bytes, truncate),
+        Plan::Atomic(old) => match atomic(&target, bytes, old)? {
+            Done::Written => Ok(()),
+            // The folder is read-only (or the owner cannot be kept), but
+            // the file itself may well be writable.
+            Done::Refused(e) if old.is_some() => in_place(&target, bytes, true).map_err(|_| e),
+            Done::Refused(e) => Err(e),
+        },
+    }
+}
+
+fn in_place(target: &Path, bytes: &[u8], truncate: bool) -> io::Result<()> {
+    let mut f = OpenOptions::new()
+        .write(true)
+        .truncate(truncate)
+        .open(target)?;
+    f.write_all(bytes)?;
+    f.flush()?;
+    if truncate {
+        // Regular files only: syncing a pipe or a terminal is an error.
+        f.sync_all()?;
+    }
+    Ok(())
+}
+
+enum Done {
+    Written,
+    /// The atomic way is closed (no temporary file, no owner): the caller
+    /// may write in place.
+    Refused(io::Error),
+}
+
+fn temp_path(target: &Path, attempt: u32) -> PathBuf {
+    let name = target
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = format!(".{name}.{}-{attempt}.btc-tmp", std::process::id());
+    match target.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.join(tmp),
+        _ => PathBuf::from(tmp),
+    }
+}
+
+fn atomic(target: &Path, bytes: &[u8], old: Option<(u32, u32, u32)>) -> io::Result<Done> {
+    let (guard, mut file) = {
+        let mut attempt = 0;
+        loop {
+            let guard = cleanup::temp(temp_path(target, attempt));
+            // 0o666 less the umask for a new file, as any tool creates one.
+            match OpenOptions::new()
+                .write(true)
+                .create_new(true)
+                .mode(if old.is_some() { 0o600 } else { 0o666 })
+                .open(guard.path())
+            {
+                Ok(f) => break (guard, f),
+                Err(e) if e.kind() == io::ErrorKind::AlreadyExists && attempt < 100 => {
+                    guard.keep(); // someone else's file: leave it
+                    attempt += 1;
+                }
+                Err(e)
+                    if matches!(
+                        e.kind(),
+                        io::ErrorKind::PermissionDenied | io::ErrorKind::ReadOnlyFilesystem
+                    ) =>
+                {
+                    guard.keep(); // never created
+                    return Ok(Done::Refused(e));
+                }
+                Err(e) => {
+                    guard.keep();
+                    return Err(e);
+                }
+            }
+        }
+    };
+    if let Some((mode, uid, gid)) = old {
+        let meta = file.metadata()?;
+        if (meta.uid(), meta.gid()) != (uid, gid) {
+            if let Err(e) = std::os::unix::fs::fchown(&file, Some(uid), Some(gid)) {
+                return Ok(Done::Refused(e));
+            }
+        }
+        file.set_permissions(std::fs::Permissions::from_mode(mode))?;
+    }
+    file.write_all(bytes)?;
+    file.sync_all()?;
+    drop(file);
+    std::fs::rename(guard.path(), target)?;
+    guard.keep();
+    // The rename is durable once the folder is synced (best effort: some
+    // file systems cannot sync a folder).
+    if let Some(dir) = target.parent().filter(|d| !d.as_os_str().is_empty()) {
+        if let Ok(d) = File::open(dir) {
+            let _ = d.sync_all();
+        }
+    }
+    Ok(Done::Written)
+}
+
+/// An output written as it is produced (a run's trace): every line handed
+/// over reaches the file at the next [`Stream::flush`], and on SIGINT or
+/// SIGTERM. Not atomic, by design: a killed run leaves what it wrote. The
+/// target is truncated in place (mode, owner and links kept; special files
+/// written as they are).
+pub struct Stream {
+    inner: Arc<Mutex<BufWriter<File>>>,
+    /// The first write error: writers that cannot return one (a closed
+    /// loop's trace) still have it reported by [`Stream::finish`].
+    error: Mutex<Option<io::Error>>,
+    _guard: cleanup::StreamGuard,
+}
+
+impl Stream {
+    pub fn create(path: &Path) -> io::Result<Stream> {
+        let target = resolve(path)?;
+        let special = matches!(std::fs::metadata(&target), Ok(m) if !m.is_file());
+        if std::fs::metadata(&target).is_ok_and(|m| m.is_dir()) {
+            return Err(io::Error::other("it is a folder"));
+        }
+        let file = OpenOptions::new()
+            .write(true)
+            .create(!special)
+            .truncate(!special)
+            .mode(0o666)
+            .open(&target)?;
+        let inner = Arc::new(Mutex::new(BufWriter::with_capacity(64 << 10, file)));
+        let flushable: Arc<cleanup::Flushable> = inner.clone();
+        let guard = cleanup::stream(&flushable);
+        Ok(Stream {
+            inner,
+            error: Mutex::new(None),
+            _guard: guard,
+        })
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, BufWriter<File>> {
+        self.inner.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    pub fn write_all(&self, bytes: &[u8]) -> io::Result<()> {
+        let r = self.lock().write_all(bytes);
+        self.note(r)
+    }
+
+    pub fn flush(&self) -> io::Result<()> {
+        let r = self.lock().flush();
+        self.note(r)
+    }
+
+    fn note(&self, r: io::Result<()>) -> io::Result<()> {
+        if let Err(e) = &r {
+            let mut first = self.error.lock().unwrap_or_else(|e| e.into_inner());
+            if first.is_none() {
+                *first = Some(io::Error::new(e.kind(), e.to_string()));
+            }
+        }
+        r
+    }
+
+    /// Flushes, and reports the first error any write met.
+    pub fn finish(self) -> io::Result<()> {
+        let flushed = self.flush();
+        let first = self.error.lock().unwrap_or_else(|e| e.into_inner()).take();
+        match first {
+            Some(e) => Err(e),
+            None => flushed,
+        }
+    }
+}
+
+/// Lines can be written to a shared stream (`&Stream`), as to a file.
+impl Write for &Stream {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        Stream::write_all(self, buf).map(|()| buf.len())
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        Stream::flush(self)
+    }
+}
+
+impl Drop for Stream {
+    fn drop(&mut self) {
+        let _ = self.lock().flush();
+    }
+}
