@@ -2,6 +2,7 @@
 //! library and prints; nothing else lives here.
 
 mod files;
+mod paths;
 mod pddl_cmd;
 mod plan_cmd;
 mod report;

@@ -34,7 +34,11 @@ pub fn run(
                 let unit = domain_unit(&sources, id);
                 diags.extend(unit.diagnostics.iter().cloned());
                 if let Some(d) = &unit.domain {
-                    models.push(serde_json::json!({ "file": path, "kind": "domain", "model": d }));
+                    if json {
+                        models.push(
+                            serde_json::json!({ "file": path, "kind": "domain", "model": d }),
+                        );
+                    }
                     format!(
                         "domain {}: {}, {}, {}",
                         d.name.name,
@@ -74,7 +78,9 @@ pub fn run(
                         );
                     }
                 }
-                models.push(serde_json::json!({ "file": path, "kind": "problem", "model": p }));
+                if json {
+                    models.push(serde_json::json!({ "file": path, "kind": "problem", "model": p }));
+                }
                 format!(
                     "problem {} (domain {}): {}, {}",
                     p.name.name,

@@ -190,7 +190,18 @@ pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
         }
         return Ok(ExitCode::from(1));
     };
-    let text = emit::emit(ir, a.emit, &a.options);
+    let text = match (&a.output, a.emit) {
+        // A JSON IR records its PDDL files relative to itself.
+        (Some(out), emit::Format::Json) => {
+            let mut ir = ir.clone();
+            let dir = out.parent().unwrap_or(Path::new(""));
+            for p in [&mut ir.domain, &mut ir.problem] {
+                *p = crate::paths::text(&crate::paths::relative_to(Path::new(p.as_str()), dir));
+            }
+            emit::emit(&ir, a.emit, &a.options)
+        }
+        _ => emit::emit(ir, a.emit, &a.options),
+    };
     let steps = ir.steps.iter().filter(|s| !s.skipped).count();
     let what = format!(
         "{steps} of {} plan steps ({} skipped); problem {}",

@@ -1,15 +1,16 @@
 //! `btc run`: compiles a plan (or loads a tree file) and executes it with
 //! the runtime against the problem's simulated world, with injected faults.
 
-use crate::{files, report, rules_cmd, Format};
+use crate::{files, paths, report, rules_cmd, Format};
 use btc_lang::db;
 use btc_lang::path::FilePath;
 use btc_lang::project::PlanSource;
-use btc_pddl::diagnostic::{has_errors, Diagnostic};
+use btc_pddl::diagnostic::{codes, has_errors, Diagnostic};
 use btc_pddl::pipeline;
 use btc_pddl::source::{FileId, Sources, Span};
 use btc_pddl::state::World;
-use btc_runtime::{Controller, Engine, Kb, LoadError, Options, Scenario, Summary, TreeDoc};
+use btc_pddl::world::WorldModel;
+use btc_runtime::{Controller, Engine, Kb, LoadError, Loaded, Options, Scenario, Summary, TreeDoc};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -176,23 +177,73 @@ fn run_tree(a: &RunArgs, tree: &Path) -> anyhow::Result<ExitCode> {
     if has_errors(&diags) {
         return fail(&diags, &sources, a.format);
     }
-    let (doc, ir) = match btc_runtime::load_tree(sources.text(file)) {
+    let loaded = match btc_runtime::load_tree(sources.text(file)) {
         Ok(x) => x,
         Err(e) => return fail(&[diagnostic(&e, file, &sources)], &sources, a.format),
     };
-    // The world: `--problem` (and `--domain`), or the files a JSON IR names.
-    let named = |p: Option<&String>| p.map(PathBuf::from).filter(|p| p.is_file());
+    // The world: a JSON IR carries it (unless `--problem` names another);
+    // XML, and version-1 IR, run in the world of PDDL files.
+    let (doc, named) = match loaded {
+        Loaded::Ir(ir) if a.problem.is_none() => {
+            let world = match World::new(ir.world.clone()) {
+                Ok(w) => w,
+                Err(m) => {
+                    let e = LoadError::new(
+                        codes::X_WORLD,
+                        format!("the world this IR carries does not fit together: {m}"),
+                    )
+                    .at(0);
+                    return fail(&[diagnostic(&e, file, &sources)], &sources, a.format);
+                }
+            };
+            let doc = TreeDoc::from_ir(&ir);
+            let shown = format!("{} (carried by the tree file)", ir.problem);
+            return execute(
+                a,
+                &doc,
+                Some(Kb::new(&world)),
+                &mut sources,
+                file,
+                Some(&shown),
+            );
+        }
+        Loaded::Ir(ir) => (Tree::Ir(ir), None),
+        Loaded::IrV1(v1) => {
+            let named = (v1.domain.clone(), v1.problem.clone());
+            (Tree::V1(v1), Some(named))
+        }
+        Loaded::Xml(doc) => (Tree::Xml(doc), None),
+    };
+    let recorded = |p: &str| -> Option<PathBuf> {
+        // Recorded paths are relative to the IR file; version 1 recorded
+        // them relative to the working directory it was compiled in.
+        [paths::beside(tree, p), PathBuf::from(p)]
+            .into_iter()
+            .find(|c| c.is_file())
+    };
     let problem_path = a
         .problem
         .clone()
-        .or_else(|| named(ir.as_ref().map(|i| &i.problem)));
+        .or_else(|| named.as_ref().and_then(|(_, p)| recorded(p)));
     let Some(problem_path) = problem_path else {
-        return execute(a, &doc, None, &mut sources, file, None);
+        return match (doc, &named) {
+            (Tree::Xml(doc), _) => execute(a, &doc, None, &mut sources, file, None),
+            (_, Some((_, p))) => {
+                let e = LoadError::new(
+                    codes::X_WORLD,
+                    format!("this version-1 IR carries no world, and its problem `{p}` is not found beside it or here"),
+                )
+                .at(0)
+                .hint("pass `--problem PROBLEM` (and `--domain DOMAIN`), or compile it again: version 2 carries its world");
+                fail(&[diagnostic(&e, file, &sources)], &sources, a.format)
+            }
+            _ => unreachable!("a current IR without --problem ran above"),
+        };
     };
     let domain_path = a
         .domain
         .clone()
-        .or_else(|| named(ir.as_ref().map(|i| &i.domain)))
+        .or_else(|| named.as_ref().and_then(|(d, _)| recorded(d)))
         .or_else(|| Some(problem_path.with_file_name("domain.pddl")).filter(|p| p.is_file()))
         .ok_or_else(|| {
             anyhow::anyhow!(
@@ -212,9 +263,19 @@ fn run_tree(a: &RunArgs, tree: &Path) -> anyhow::Result<ExitCode> {
     if has_errors(&diags) {
         return fail(&diags, &sources, a.format);
     }
-    let world =
-        World::of_checked(domain, &du.index, problem, &pu.index).map_err(anyhow::Error::msg)?;
-    let doc = doc.with_actions(domain);
+    let model = WorldModel::from_checked(domain, &du.index, problem, &pu.index);
+    let world = World::new(model.clone()).map_err(anyhow::Error::msg)?;
+    let doc = match doc {
+        Tree::Xml(doc) => doc.with_actions(domain),
+        Tree::Ir(ir) => TreeDoc::from_ir(&ir),
+        Tree::V1(v1) => match v1.upgrade(model) {
+            Ok(ir) => TreeDoc::from_ir(&ir),
+            Err(m) => {
+                let e = LoadError::new(codes::X_KB, m).at(0);
+                return fail(&[diagnostic(&e, file, &sources)], &sources, a.format);
+            }
+        },
+    };
     let how = if a.problem.is_some() {
         "given"
     } else {
@@ -229,6 +290,14 @@ fn run_tree(a: &RunArgs, tree: &Path) -> anyhow::Result<ExitCode> {
         file,
         Some(&shown),
     )
+}
+
+/// A loaded tree still waiting for its world.
+#[allow(clippy::large_enum_variant)] // one per run
+enum Tree {
+    Xml(TreeDoc),
+    Ir(btc_ir::TreeIr),
+    V1(btc_ir::json::V1),
 }
 
 /// Runs a tree; `problem` is the problem as the summary names it.

@@ -281,3 +281,121 @@ fn an_xml_tree_checks_step_preconditions_from_the_domain() {
         "{text}"
     );
 }
+
+/// `btc` with the working directory `dir`.
+fn btc_in(dir: &std::path::Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_btc"))
+        .args(args)
+        .env("NO_COLOR", "1")
+        .current_dir(dir)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn a_json_ir_carries_its_world_and_runs_from_its_own_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().join("out");
+    std::fs::create_dir(&out_dir).unwrap();
+    let rules = format!(
+        "{}/examples/ariac/rules.btrules",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let tree = out_dir.join("p01.json");
+    let out = btc(&[
+        "compile",
+        &rules,
+        "--plan",
+        "examples/ariac/plan.txt",
+        "--emit",
+        "json",
+        "-o",
+        tree.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let ir: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&tree).unwrap()).unwrap();
+    assert_eq!(ir["ir_version"], 2);
+    // Recorded relative to the JSON file, never as `//home/...`.
+    let domain = ir["domain"].as_str().unwrap();
+    assert!(
+        !domain.starts_with('/') && !domain.contains("//"),
+        "{domain}"
+    );
+    assert!(out_dir.join(domain).is_file(), "{domain}");
+    // `cd out && btc run --tree p01.json`: no PDDL file needed.
+    let out = btc_in(&out_dir, &["run", "--tree", "p01.json", "--format", "json"]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(summary(&out)["goal_reached"], true);
+    // Even with the PDDL files gone.
+    let moved = dir.path().join("elsewhere.json");
+    std::fs::copy(&tree, &moved).unwrap();
+    let out = btc_in(
+        dir.path(),
+        &["run", "--tree", "elsewhere.json", "--format", "json"],
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn version_1_json_files_still_run() {
+    // Written by btc before the IR carried its world: paths relative to the
+    // folder it was compiled in (the repository), formulas as strings, and
+    // a backchained plan's `KbHolds` formulas as text ports.
+    for file in ["ariac", "workshop_backchained"] {
+        let tree = format!("tests/fixtures/ir_v1/{file}.json");
+        let out = btc(&["run", "--tree", &tree, "--format", "json"]);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{file}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let s = summary(&out);
+        assert_eq!(s["goal_reached"], true, "{file}");
+        assert_eq!(s["steps_done"], s["steps_total"], "{file}");
+    }
+    // Its paths are also found relative to the file itself.
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(format!(
+        "{}/tests/fixtures/ir_v1/ariac.json",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .unwrap();
+    let root = env!("CARGO_MANIFEST_DIR");
+    for f in ["domain.pddl", "problem.pddl"] {
+        std::fs::copy(format!("{root}/examples/ariac/{f}"), dir.path().join(f)).unwrap();
+    }
+    let text = text
+        .replace("examples/ariac/domain.pddl", "domain.pddl")
+        .replace("examples/ariac/problem.pddl", "problem.pddl");
+    std::fs::write(dir.path().join("v1.json"), text).unwrap();
+    let out = btc(&[
+        "run",
+        "--tree",
+        dir.path().join("v1.json").to_str().unwrap(),
+        "--format",
+        "json",
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}

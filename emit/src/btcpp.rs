@@ -81,13 +81,19 @@ pub fn element_name(id: &str) -> String {
 struct Xml {
     out: String,
     depth: usize,
+    /// Where values are printed before they are escaped.
+    scratch: String,
 }
 
 impl Xml {
     fn new(capacity: usize) -> Xml {
         let mut out = String::with_capacity(capacity);
         out.push_str(r#"<?xml version="1.0" encoding="UTF-8"?>"#);
-        Xml { out, depth: 0 }
+        Xml {
+            out,
+            depth: 0,
+            scratch: String::new(),
+        }
     }
 
     fn newline(&mut self) {
@@ -110,6 +116,21 @@ impl Xml {
         self.out.push_str(key);
         self.out.push_str("=\"");
         escape_attr_into(&mut self.out, value);
+        self.out.push('"');
+        self
+    }
+
+    /// An attribute whose value is `value` printed (and escaped); empty
+    /// for none.
+    fn attr_display(&mut self, key: &str, value: Option<&impl std::fmt::Display>) -> &mut Xml {
+        self.scratch.clear();
+        if let Some(v) = value {
+            let _ = write!(self.scratch, "{v}");
+        }
+        self.out.push(' ');
+        self.out.push_str(key);
+        self.out.push_str("=\"");
+        escape_attr_into(&mut self.out, &self.scratch);
         self.out.push('"');
         self
     }
@@ -263,10 +284,8 @@ fn node(x: &mut Xml, n: &Node, ir: &TreeIr) {
                 }
             });
             number(x, "step", step + 1);
-            let start = info.and_then(|s| s.eff_start.as_deref()).unwrap_or("");
-            let end = info.and_then(|s| s.eff_end.as_deref()).unwrap_or("");
-            x.attr("start_effect", start)
-                .attr("end_effect", end)
+            x.attr_display("start_effect", info.and_then(|s| s.eff_start.as_ref()))
+                .attr_display("end_effect", info.and_then(|s| s.eff_end.as_ref()))
                 .close(false);
             node(x, child, ir);
             x.end("KbStep");

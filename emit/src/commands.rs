@@ -16,7 +16,7 @@ fn port_json(v: &PortValue) -> Value {
         PortValue::Int(n) => json!(n),
         PortValue::Float(f) => json!(f),
         PortValue::Bool(b) => json!(b),
-        PortValue::Param(p) => json!(format!("{{{p}}}")),
+        PortValue::Param(_) | PortValue::Formula(_) | PortValue::Effect(_) => json!(v.to_text()),
     }
 }
 

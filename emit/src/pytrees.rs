@@ -16,6 +16,7 @@
 
 use btc_ir::{format_float, LeafKind, Node, NodeModel, Port, PortValue, StepInfo, TreeIr};
 use btc_ir::{ControlKind, DecoratorKind};
+use btc_pddl::logic::{InitFact, Term, TypeText};
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write;
 
@@ -216,6 +217,7 @@ fn py_value(v: &PortValue) -> String {
         PortValue::Bool(b) => if *b { "True" } else { "False" }.into(),
         // An unbound parameter (a call that could not be inlined): its name.
         PortValue::Param(_) => py_str(&v.to_text()),
+        PortValue::Formula(_) | PortValue::Effect(_) => py_str(&v.to_text()),
     }
 }
 
@@ -234,90 +236,6 @@ fn py_float(f: f64) -> String {
     }
 }
 
-fn py_opt_str(s: Option<&str>) -> String {
-    s.map_or_else(|| "None".into(), py_str)
-}
-
-// ---------------------------------------------------------------------------
-// Just enough s-expressions to read ground facts and find predicate arities.
-
-#[derive(Debug, PartialEq)]
-enum Sx {
-    Atom(String),
-    List(Vec<Sx>),
-}
-
-/// One s-expression; `None` when the text is not exactly one.
-fn parse_sx(text: &str) -> Option<Sx> {
-    let mut stack: Vec<Vec<Sx>> = vec![Vec::new()];
-    let mut word = String::new();
-    let flush = |word: &mut String, stack: &mut Vec<Vec<Sx>>| {
-        if !word.is_empty() {
-            let w = std::mem::take(word).to_lowercase();
-            stack.last_mut().expect("non-empty").push(Sx::Atom(w));
-        }
-    };
-    for c in text.chars() {
-        match c {
-            '(' => {
-                flush(&mut word, &mut stack);
-                stack.push(Vec::new());
-            }
-            ')' => {
-                flush(&mut word, &mut stack);
-                if stack.len() < 2 {
-                    return None;
-                }
-                let done = stack.pop().expect("checked");
-                stack.last_mut().expect("checked").push(Sx::List(done));
-            }
-            c if c.is_whitespace() => flush(&mut word, &mut stack),
-            c => word.push(c),
-        }
-    }
-    flush(&mut word, &mut stack);
-    let mut top = stack.pop()?;
-    if !stack.is_empty() || top.len() != 1 {
-        return None;
-    }
-    top.pop()
-}
-
-/// A ground atom `(p a b)` as its names.
-fn flat_atom(sx: &Sx) -> Option<Vec<&str>> {
-    match sx {
-        Sx::List(items) if !items.is_empty() => items
-            .iter()
-            .map(|i| match i {
-                Sx::Atom(a) => Some(a.as_str()),
-                Sx::List(_) => None,
-            })
-            .collect(),
-        _ => None,
-    }
-}
-
-/// Records the arity of every predicate atom in a formula or effect.
-fn collect_arities(sx: &Sx, out: &mut BTreeMap<String, usize>) {
-    let Sx::List(items) = sx else { return };
-    let Some(Sx::Atom(head)) = items.first() else {
-        return;
-    };
-    match head.as_str() {
-        "and" | "or" | "not" | "imply" | "when" => {
-            items[1..].iter().for_each(|i| collect_arities(i, out));
-        }
-        "exists" | "forall" => items.iter().skip(2).for_each(|i| collect_arities(i, out)),
-        "=" | "<" | "<=" | ">" | ">=" | "increase" | "decrease" | "assign" | "scale-up"
-        | "scale-down" => {}
-        _ => {
-            if let Some(atom) = flat_atom(sx) {
-                out.entry(atom[0].to_owned()).or_insert(atom.len() - 1);
-            }
-        }
-    }
-}
-
 // ---------------------------------------------------------------------------
 
 /// How a leaf id is built in the module.
@@ -325,7 +243,7 @@ struct LeafClass {
     /// The Python expression naming the class.
     expr: String,
     kind: LeafKind,
-    formula: Option<String>,
+    formula: Option<btc_pddl::logic::Formula>,
     /// Generated here (simulated or `std::kb`), not imported.
     generated: bool,
 }
@@ -374,7 +292,7 @@ pub fn emit(ir: &TreeIr, node_module: Option<&str>) -> String {
     e.plan_classes(&root, node_module);
     e.header(node_module);
     e.out.push_str(RUNTIME_PDDL);
-    e.knowledge_base(&root);
+    e.knowledge_base();
     e.out.push_str(RUNTIME_KB);
     e.steps();
     e.out.push_str(RUNTIME_NODES);
@@ -481,90 +399,59 @@ impl Emitter<'_> {
         }
     }
 
-    fn knowledge_base(&mut self, root: &Node) {
-        let ir = self.ir;
+    fn knowledge_base(&mut self) {
+        let w = &self.ir.world;
         let o = &mut self.out;
         o.push_str(
             "\n\n# ---------------------------------------------------------------------------\n\
              # The problem: objects with their type, initial facts, goal\n\n",
         );
         o.push_str("OBJECTS = {\n");
-        for (name, ty) in &ir.objects {
-            let _ = writeln!(o, "    {}: {},", py_str(name), py_str(ty));
+        for obj in &w.objects {
+            let ty = TypeText(&obj.types).to_string();
+            let _ = writeln!(o, "    {}: {},", py_str(&obj.name), py_str(&ty));
         }
         o.push_str("}\n\n");
 
+        let tuple = |head: &str, args: &[Term]| -> String {
+            let mut items = vec![py_str(head)];
+            items.extend(args.iter().map(|t| py_str(&t.to_string())));
+            let comma = if items.len() == 1 { "," } else { "" };
+            format!("({}{comma})", items.join(", "))
+        };
         o.push_str("INITIAL_FACTS = frozenset(\n    [\n");
-        for fact in &ir.init {
-            match parse_sx(fact).as_ref().and_then(flat_atom) {
-                Some(names) => {
-                    let items: Vec<String> = names.iter().map(|n| py_str(n)).collect();
-                    let comma = if items.len() == 1 { "," } else { "" };
-                    let _ = writeln!(o, "        ({}{comma}),", items.join(", "));
-                }
-                None => {
-                    let _ = writeln!(o, "        _as_fact(parse_pddl({})),", py_str(fact));
-                }
+        for f in &w.init {
+            if let InitFact::Atom(a) = f {
+                let _ = writeln!(o, "        {},", tuple(&a.pred, &a.args));
             }
         }
         o.push_str("    ]\n)\n\n");
-        o.push_str(
-            "# Numeric fluents, by ground application. The IR carries no initial\n\
-             # values, so every fluent starts at 0 (enough for `(total-cost)`).\n\
-             INITIAL_FLUENTS = {}\n\n",
-        );
-
-        // Arities of every predicate the module may read or write.
-        let mut arities = BTreeMap::new();
-        let mut texts: Vec<&str> = ir.init.iter().map(String::as_str).collect();
-        texts.extend(ir.goal.as_deref());
-        for s in &ir.steps {
-            texts.extend(
-                [
-                    &s.pre_start,
-                    &s.pre_over_all,
-                    &s.pre_end,
-                    &s.eff_start,
-                    &s.eff_end,
-                ]
-                .into_iter()
-                .filter_map(|t| t.as_deref()),
-            );
-        }
-        texts.extend(ir.nodes.iter().filter_map(|n| n.formula.as_deref()));
-        let mut port_texts = Vec::new();
-        root.walk(&mut |n| {
-            if let Node::Leaf { id, ports, .. } = n {
-                if id == "KbHolds" || id == "KbApply" {
-                    for p in ports {
-                        if let PortValue::Text(t) = &p.value {
-                            port_texts.push(t.clone());
-                        }
-                    }
-                }
-            }
-        });
-        texts.extend(port_texts.iter().map(String::as_str));
-        for t in texts {
-            if let Some(sx) = parse_sx(t) {
-                collect_arities(&sx, &mut arities);
+        o.push_str("# Numeric fluents, by ground application, with their initial values.\nINITIAL_FLUENTS = {\n");
+        for f in &w.init {
+            if let InitFact::Value(a, v) = f {
+                let _ = writeln!(o, "    {}: {},", tuple(&a.pred, &a.args), py_float(*v));
             }
         }
+        o.push_str("}\n\n");
         o.push_str(
             "# Each predicate's parameter positions, in the order facts store them.\n\
              PREDICATE_PARAMETER_ORDER = {\n",
         );
-        for (pred, n) in &arities {
-            let positions: Vec<String> = (0..*n).map(|i| i.to_string()).collect();
-            let _ = writeln!(o, "    {}: [{}],", py_str(pred), positions.join(", "));
+        let mut preds: Vec<_> = w.predicates.iter().collect();
+        preds.sort_by(|a, b| a.name.cmp(&b.name));
+        preds.dedup_by(|a, b| a.name == b.name);
+        for p in preds {
+            let positions: Vec<String> = (0..p.params.len()).map(|i| i.to_string()).collect();
+            let _ = writeln!(o, "    {}: [{}],", py_str(&p.name), positions.join(", "));
         }
         o.push_str("}\n\n");
         let _ = writeln!(
             o,
             "GOAL = {}",
-            ir.goal
-                .as_deref()
-                .map_or_else(|| "None".into(), |g| format!("parse_pddl({})", py_str(g)))
+            w.goal.as_ref().map_or_else(
+                || "None".into(),
+                |g| format!("parse_pddl({})", py_str(&g.to_string()))
+            )
         );
     }
 
@@ -603,7 +490,7 @@ impl Emitter<'_> {
                 py_str(id)
             );
             if let Some(f) = &class.formula {
-                let _ = writeln!(o, "    FORMULA = parse_pddl({})", py_str(f));
+                let _ = writeln!(o, "    FORMULA = parse_pddl({})", py_str(&f.to_string()));
             }
         }
     }
@@ -783,15 +670,19 @@ fn step_literal(s: &StepInfo) -> String {
         s.index,
         py_str(&s.display())
     );
-    for (key, text) in [
+    let conditions = [
         ("pre_start", &s.pre_start),
         ("pre_over_all", &s.pre_over_all),
         ("pre_end", &s.pre_end),
-        ("eff_start", &s.eff_start),
-        ("eff_end", &s.eff_end),
-    ] {
-        if text.is_some() {
-            let _ = writeln!(out, "        {key}={},", py_opt_str(text.as_deref()));
+    ];
+    for (key, f) in conditions {
+        if let Some(f) = f {
+            let _ = writeln!(out, "        {key}={},", py_str(&f.to_string()));
+        }
+    }
+    for (key, e) in [("eff_start", &s.eff_start), ("eff_end", &s.eff_end)] {
+        if let Some(e) = e {
+            let _ = writeln!(out, "        {key}={},", py_str(&e.to_string()));
         }
     }
     if let Some(d) = s.duration {
@@ -1444,21 +1335,6 @@ mod tests {
             kwargs(&[port("a", "x"), port("class", "y"), port("größe", "z\n")]),
             ", a=\"x\", **{\"class\": \"y\", \"gr\\xf6\\xdfe\": \"z\\n\"}"
         );
-    }
-
-    #[test]
-    fn facts_and_arities_are_read() {
-        let sx = parse_sx("(On Battery_Red bin1)").unwrap();
-        assert_eq!(flat_atom(&sx), Some(vec!["on", "battery_red", "bin1"]));
-        assert_eq!(parse_sx("(a) (b)"), None);
-        assert_eq!(parse_sx("(a"), None);
-        assert_eq!(parse_sx("a)"), None);
-        let mut ar = BTreeMap::new();
-        let f = "(and (p a) (not (q a b)) (forall (?x - t) (when (r ?x) (s))) \
-                 (increase (total-cost) 1) (exists (?y) (= ?y a)))";
-        collect_arities(&parse_sx(f).unwrap(), &mut ar);
-        let got: Vec<(&str, usize)> = ar.iter().map(|(k, v)| (k.as_str(), *v)).collect();
-        assert_eq!(got, vec![("p", 1), ("q", 2), ("r", 1), ("s", 0)]);
     }
 
     #[test]

@@ -30,7 +30,10 @@ fuzz_target!(|data: &[u8]| {
         return;
     };
     let (d, p) = ariac();
-    let kb = Kb::new(d.domain.as_ref().unwrap(), &d.index, p.problem.as_ref().unwrap(), &p.index);
+    let Ok(world) = btc_pddl::state::World::of_checked(d.domain.as_ref().unwrap(), &d.index, p.problem.as_ref().unwrap(), &p.index) else {
+        return;
+    };
+    let kb = Kb::new(&world);
     let (doc, _) = btc_runtime::load_tree(TREE).expect("the fixed tree loads");
     let mut e = Engine::build(&doc, Some(kb), Options::default()).expect("builds");
     if e.add_faults(&s).is_ok() {

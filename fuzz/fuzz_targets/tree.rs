@@ -29,7 +29,10 @@ fuzz_target!(|data: &[u8]| {
         return;
     };
     let (d, p) = ariac();
-    let kb = Kb::new(d.domain.as_ref().unwrap(), &d.index, p.problem.as_ref().unwrap(), &p.index);
+    let Ok(world) = btc_pddl::state::World::of_checked(d.domain.as_ref().unwrap(), &d.index, p.problem.as_ref().unwrap(), &p.index) else {
+        return;
+    };
+    let kb = Kb::new(&world);
     let opts = Options { trace: true, ..Options::default() };
     if let Ok(mut e) = Engine::build(&doc, Some(kb), opts) {
         e.run(200, |e| {

@@ -4,13 +4,22 @@
 //! A step's subtree is a call of the rule's parametric tree (a BT.CPP
 //! `<SubTree>` with port remapping); [`TreeIr::inlined`] expands every call
 //! for formats and engines that want one flat tree.
+//!
+//! PDDL is structured here: conditions, effects and the world are
+//! `btc_pddl::logic` values. In JSON a formula is its PDDL text, decoded
+//! once when the IR is read ([`json`]).
 
+use btc_pddl::logic::{Effect, Formula};
+use btc_pddl::world::WorldModel;
 use serde::{Deserialize, Serialize};
 
+pub mod json;
 mod nodes;
 pub use nodes::{ControlKind, DecoratorKind};
 
-pub const IR_VERSION: u32 = 1;
+/// The version of the IR's JSON encoding (`"ir_version"`). Version 1 (PDDL
+/// as strings, no world) is still read: [`json::decode`].
+pub const IR_VERSION: u32 = 2;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", content = "value", rename_all = "lowercase")]
@@ -21,6 +30,10 @@ pub enum PortValue {
     Bool(bool),
     /// A port of the enclosing tree (`{name}` in BT.CPP).
     Param(String),
+    /// A ground PDDL condition (`KbHolds`' `formula`).
+    Formula(Formula),
+    /// A ground PDDL effect (`KbApply`'s `effect`).
+    Effect(Effect),
 }
 
 impl PortValue {
@@ -32,6 +45,8 @@ impl PortValue {
             PortValue::Float(f) => format_float(*f),
             PortValue::Bool(b) => b.to_string(),
             PortValue::Param(p) => format!("{{{p}}}"),
+            PortValue::Formula(f) => f.to_string(),
+            PortValue::Effect(e) => e.to_string(),
         }
     }
 }
@@ -133,8 +148,9 @@ pub struct NodeModel {
     pub id: String,
     pub kind: LeafKind,
     pub ports: Vec<PortModel>,
-    /// For a condition defined by a formula: PDDL text over `?port` variables.
-    pub formula: Option<String>,
+    /// For a condition defined by a formula: a formula over `?port`
+    /// variables.
+    pub formula: Option<Formula>,
 }
 
 /// One plan step as compiled.
@@ -150,12 +166,14 @@ pub struct StepInfo {
     /// The id of the rule tree it calls; `None` for a skipped step.
     pub rule: Option<String>,
     pub skipped: bool,
-    /// Ground PDDL conditions and effects, by when they apply.
-    pub pre_start: Option<String>,
-    pub pre_over_all: Option<String>,
-    pub pre_end: Option<String>,
-    pub eff_start: Option<String>,
-    pub eff_end: Option<String>,
+    /// Ground conditions and effects, by when they apply. The effects are
+    /// the step's: its rule's `effect` when the rule gives one, else the
+    /// PDDL action's.
+    pub pre_start: Option<Formula>,
+    pub pre_over_all: Option<Formula>,
+    pub pre_end: Option<Formula>,
+    pub eff_start: Option<Effect>,
+    pub eff_end: Option<Effect>,
     /// Steps that must finish before this one (`steps parallel`).
     pub after: Vec<usize>,
 }
@@ -175,7 +193,10 @@ impl StepInfo {
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TreeIr {
+    #[serde(rename = "ir_version")]
     pub version: u32,
+    /// The PDDL files it was compiled from (relative to the JSON file when
+    /// written with `-o`); informative: the world is [`TreeIr::world`].
     pub domain: String,
     pub problem: String,
     pub main_tree: String,
@@ -183,11 +204,9 @@ pub struct TreeIr {
     pub trees: Vec<TreeDef>,
     pub nodes: Vec<NodeModel>,
     pub steps: Vec<StepInfo>,
-    /// The problem's objects (and the domain's constants) with their type.
-    pub objects: Vec<(String, String)>,
-    /// The problem's initial facts, e.g. `(on battery_red bin1)`.
-    pub init: Vec<String>,
-    pub goal: Option<String>,
+    /// The world the tree runs in: types, objects, signatures, derived
+    /// rules, initial facts and values, goal.
+    pub world: WorldModel,
 }
 
 /// Deepest chain of subtree calls [`TreeIr::inlined`] expands.

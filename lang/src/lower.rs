@@ -9,11 +9,19 @@ use crate::rules::check::Decls;
 use crate::rules::matching::{match_args, match_name, Bindings, Captures, ObjectTypes};
 use btc_ir::format_float;
 use btc_ir::*;
-use btc_pddl::ast::{Action, Domain, Effect, Formula, Problem, Term};
+use btc_pddl::ast::{Domain, Problem};
 use btc_pddl::check::{DomainIndex, ProblemIndex};
 use btc_pddl::diagnostic::{codes, Diagnostic};
+use btc_pddl::logic::{self, Formula, Name};
 use btc_pddl::plan::{GroundStep, Plan};
+use btc_pddl::world::WorldModel;
 use std::collections::{BTreeMap, BTreeSet};
+
+mod action;
+mod arrange;
+
+use action::ActionLogic;
+use arrange::kb_holds;
 
 pub struct LowerInput<'a> {
     pub decls: &'a Decls,
@@ -41,260 +49,6 @@ impl ObjectTypes for Types<'_> {
             (Some(o), Some(t)) => self.dix.types.fits(&o.types, &[t]),
             _ => false,
         }
-    }
-}
-
-/// A PDDL formula or effect with its action's parameters cut out, so a step's
-/// ground text is a concatenation instead of a fresh formatting.
-#[derive(Clone, Debug)]
-struct Spliced(Vec<Seg>);
-
-#[derive(Clone, Debug)]
-enum Seg {
-    Lit(String),
-    Arg(usize),
-}
-
-const MARK: char = '\u{1}';
-
-impl Spliced {
-    fn new(text: &str) -> Spliced {
-        let mut segs = Vec::new();
-        for (i, part) in text.split(MARK).enumerate() {
-            if i % 2 == 0 {
-                if !part.is_empty() {
-                    segs.push(Seg::Lit(part.to_owned()));
-                }
-            } else {
-                segs.push(Seg::Arg(part.parse().expect("marker holds an index")));
-            }
-        }
-        Spliced(segs)
-    }
-
-    fn ground(&self, args: &[String]) -> String {
-        let mut s = String::new();
-        for seg in &self.0 {
-            match seg {
-                Seg::Lit(l) => s.push_str(l),
-                Seg::Arg(i) => s.push_str(&args[*i]),
-            }
-        }
-        s
-    }
-}
-
-/// Replaces an action's parameters by markers in a formula or effect.
-fn mark_params<T: Clone + serde::Serialize + serde::de::DeserializeOwned>(
-    x: &T,
-    action: &Action,
-) -> T {
-    // Through JSON: one generic walk over every `Term::Var`.
-    let mut v = serde_json::to_value(x).expect("model serializes");
-    fn walk(v: &mut serde_json::Value, action: &Action) {
-        match v {
-            serde_json::Value::Object(m) => {
-                if m.get("kind").and_then(|k| k.as_str()) == Some("var") {
-                    if let Some(name) = m
-                        .get("name")
-                        .and_then(|n| n.get("name"))
-                        .and_then(|n| n.as_str())
-                    {
-                        if let Some(i) = action.params.iter().position(|p| p.name.name == name) {
-                            m.insert("kind".into(), "const".into());
-                            m["name"]["name"] = format!("{MARK}{i}{MARK}").into();
-                        }
-                    }
-                }
-                m.values_mut().for_each(|x| walk(x, action));
-            }
-            serde_json::Value::Array(a) => a.iter_mut().for_each(|x| walk(x, action)),
-            _ => {}
-        }
-    }
-    walk(&mut v, action);
-    serde_json::from_value(v).expect("same shape")
-}
-
-fn conj(parts: &[Formula]) -> Option<String> {
-    (!parts.is_empty()).then(|| btc_pddl::print::conjunction(parts))
-}
-
-fn effs(parts: &[Effect]) -> Option<String> {
-    let non_empty: Vec<&Effect> = parts
-        .iter()
-        .filter(|e| !matches!(e, Effect::And { parts, .. } if parts.is_empty()))
-        .collect();
-    match non_empty.as_slice() {
-        [] => None,
-        [one] => Some(one.to_string()),
-        many => Some(format!(
-            "(and {})",
-            many.iter()
-                .map(|e| e.to_string())
-                .collect::<Vec<_>>()
-                .join(" ")
-        )),
-    }
-}
-
-/// An action's conditions and effects, ready to be grounded.
-struct ActionTexts {
-    pre_start: Option<Spliced>,
-    pre_over_all: Option<Spliced>,
-    pre_end: Option<Spliced>,
-    eff_start: Option<Spliced>,
-    eff_end: Option<Spliced>,
-    /// Effects as a condition ("already done"), for `steps backchained`.
-    done: Option<Spliced>,
-    /// Literals (positive?, predicate, arg slots) when conditions and effects
-    /// are plain conjunctions; `None` otherwise (ordered conservatively).
-    literals: Option<Literals>,
-}
-
-#[derive(Clone, Debug, Default)]
-struct Literals {
-    pre: Vec<(bool, String, Vec<Slot>)>,
-    eff: Vec<(bool, String, Vec<Slot>)>,
-}
-
-#[derive(Clone, Debug)]
-enum Slot {
-    Param(usize),
-    Const(String),
-}
-
-fn slots(args: &[Term], action: &Action) -> Option<Vec<Slot>> {
-    args.iter()
-        .map(|t| match t {
-            Term::Var { name } => action
-                .params
-                .iter()
-                .position(|p| p.name.name == name.name)
-                .map(Slot::Param),
-            Term::Const { name } => Some(Slot::Const(name.name.clone())),
-        })
-        .collect()
-}
-
-fn formula_literals(
-    f: &Formula,
-    action: &Action,
-    out: &mut Vec<(bool, String, Vec<Slot>)>,
-) -> Option<()> {
-    match f {
-        Formula::Atom { atom } => {
-            out.push((true, atom.pred.name.clone(), slots(&atom.args, action)?))
-        }
-        Formula::Not { formula, .. } => match &**formula {
-            Formula::Atom { atom } => {
-                out.push((false, atom.pred.name.clone(), slots(&atom.args, action)?))
-            }
-            Formula::Equal { .. } => {}
-            _ => return None,
-        },
-        Formula::And { parts, .. } => {
-            for p in parts {
-                formula_literals(p, action, out)?;
-            }
-        }
-        Formula::Equal { .. } => {}
-        _ => return None,
-    }
-    Some(())
-}
-
-fn effect_literals(
-    e: &Effect,
-    action: &Action,
-    out: &mut Vec<(bool, String, Vec<Slot>)>,
-) -> Option<()> {
-    match e {
-        Effect::Add { atom } => {
-            out.push((true, atom.pred.name.clone(), slots(&atom.args, action)?))
-        }
-        Effect::Delete { atom, .. } => {
-            out.push((false, atom.pred.name.clone(), slots(&atom.args, action)?))
-        }
-        Effect::And { parts, .. } => {
-            for p in parts {
-                effect_literals(p, action, out)?;
-            }
-        }
-        // Action costs never order steps: increases commute.
-        Effect::Numeric { fluent, .. } if fluent.pred.name == "total-cost" => {}
-        _ => return None,
-    }
-    Some(())
-}
-
-impl ActionTexts {
-    fn new(a: &Action) -> ActionTexts {
-        let sp = |t: Option<String>| t.map(|t| Spliced::new(&t));
-        let pre_start: Vec<Formula> = a.pre_start.iter().map(|f| mark_params(f, a)).collect();
-        let over: Vec<Formula> = a.pre_over_all.iter().map(|f| mark_params(f, a)).collect();
-        let pre_end: Vec<Formula> = a.pre_end.iter().map(|f| mark_params(f, a)).collect();
-        let eff_start: Vec<Effect> = a.eff_start.iter().map(|e| mark_params(e, a)).collect();
-        let eff_end: Vec<Effect> = a.eff_end.iter().map(|e| mark_params(e, a)).collect();
-        let mut lits = Literals::default();
-        let simple = a
-            .pre_start
-            .iter()
-            .chain(&a.pre_over_all)
-            .chain(&a.pre_end)
-            .all(|f| formula_literals(f, a, &mut lits.pre).is_some())
-            && a.eff_start
-                .iter()
-                .chain(&a.eff_end)
-                .all(|e| effect_literals(e, a, &mut lits.eff).is_some());
-        // "Already done": the net effect as a condition, when it is plain.
-        let mut net = Vec::new();
-        let done = if eff_start
-            .iter()
-            .chain(&eff_end)
-            .all(|e| effect_literals(e, a, &mut net).is_some())
-            && !net.is_empty()
-        {
-            let mut marked_net = Vec::new();
-            for e in eff_start.iter().chain(&eff_end) {
-                collect_marked(e, &mut marked_net);
-            }
-            // A later literal on the same atom wins (add after delete).
-            let mut last: Vec<(bool, String)> = Vec::new();
-            for (pos, atom) in marked_net {
-                last.retain(|(_, a)| *a != atom);
-                last.push((pos, atom));
-            }
-            let parts: Vec<String> = last
-                .into_iter()
-                .map(|(pos, atom)| if pos { atom } else { format!("(not {atom})") })
-                .collect();
-            Some(if parts.len() == 1 {
-                parts[0].clone()
-            } else {
-                format!("(and {})", parts.join(" "))
-            })
-        } else {
-            None
-        };
-        ActionTexts {
-            pre_start: sp(conj(&pre_start)),
-            pre_over_all: sp(conj(&over)),
-            pre_end: sp(conj(&pre_end)),
-            eff_start: sp(effs(&eff_start)),
-            eff_end: sp(effs(&eff_end)),
-            done: sp(done),
-            literals: simple.then_some(lits),
-        }
-    }
-}
-
-fn collect_marked(e: &Effect, out: &mut Vec<(bool, String)>) {
-    match e {
-        Effect::Add { atom } => out.push((true, atom.to_string())),
-        Effect::Delete { atom, .. } => out.push((false, atom.to_string())),
-        Effect::And { parts, .. } => parts.iter().for_each(|p| collect_marked(p, out)),
-        _ => {}
     }
 }
 
@@ -683,18 +437,6 @@ fn rule_id(r: &Rule, taken: &BTreeSet<String>) -> String {
     id
 }
 
-fn kb_leaf(leaf: LeafKind, id: &str, port: &str, value: String, name: Option<String>) -> Node {
-    Node::Leaf {
-        leaf,
-        id: id.to_owned(),
-        name,
-        ports: vec![Port {
-            name: port.to_owned(),
-            value: PortValue::Text(value),
-        }],
-    }
-}
-
 /// Lowers a plan; every problem is reported at the plan line of its step.
 pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
     let mut diags = Vec::new();
@@ -703,7 +445,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
         pix: input.pix,
     };
     let tables = |name: &str| input.decls.tables.get(name).cloned();
-    let mut texts: BTreeMap<usize, ActionTexts> = BTreeMap::new();
+    let mut actions: BTreeMap<usize, ActionLogic> = BTreeMap::new();
     let mut rule_trees: Vec<(usize, RuleTree)> = Vec::new(); // by rule index
     let mut taken = BTreeSet::new();
     let mut used_nodes = BTreeSet::new();
@@ -713,39 +455,39 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
     let mut step_nodes: Vec<Option<Node>> = Vec::with_capacity(input.steps.len());
     let no_bindings = Bindings::new();
     let no_captures = Captures::new();
+    let object_names: Vec<Name> = input
+        .pix
+        .object_names
+        .iter()
+        .map(|n| logic::name(n))
+        .collect();
 
     for (k, g) in input.steps.iter().enumerate() {
         let step = &input.plan.steps[g.step];
         let action = &input.domain.actions[g.action];
-        let args: Vec<String> = g
+        let objects: Vec<Name> = g
             .args
             .iter()
-            .map(|&o| input.pix.object_names[o as usize].clone())
+            .map(|&o| object_names[o as usize].clone())
             .collect();
-        let t = texts
+        let ground = actions
             .entry(g.action)
-            .or_insert_with(|| ActionTexts::new(action));
-        let ground = |s: &Option<Spliced>| s.as_ref().map(|s| s.ground(&args));
-        let (pre_start, pre_over_all, pre_end) = (
-            ground(&t.pre_start),
-            ground(&t.pre_over_all),
-            ground(&t.pre_end),
-        );
-        let (eff_start, eff_end) = (ground(&t.eff_start), ground(&t.eff_end));
+            .or_insert_with(|| ActionLogic::new(action))
+            .ground(&objects);
         let mut info = StepInfo {
             index: k,
             line: step.line,
             action: action.name.name.clone(),
-            args,
+            args: objects.iter().map(|o| o.to_string()).collect(),
             time: step.time,
             duration: step.duration,
             rule: None,
             skipped: false,
-            pre_start,
-            pre_over_all,
-            pre_end,
-            eff_start,
-            eff_end,
+            pre_start: ground.pre_start,
+            pre_over_all: ground.pre_over_all,
+            pre_end: ground.pre_end,
+            eff_start: ground.eff_start,
+            eff_end: ground.eff_end,
             after: Vec::new(),
         };
         let args = &info.args;
@@ -878,16 +620,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
             child = Node::Control {
                 control: ControlKind::ReactiveSequence,
                 name: Some(format!("while {over}")),
-                children: vec![
-                    kb_leaf(
-                        LeafKind::Condition,
-                        "KbHolds",
-                        "formula",
-                        over.clone(),
-                        None,
-                    ),
-                    child,
-                ],
+                children: vec![kb_holds(over.clone(), None), child],
             };
         }
         step_nodes.push(Some(Node::Step {
@@ -904,7 +637,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
     let template = input.plan_template;
     let uses_parallel = template.is_some_and(|t| uses_mode(t, StepsMode::Parallel));
     if uses_parallel {
-        order_steps(input, &texts, &mut infos);
+        arrange::order_steps(&mut infos);
     }
     let mut used_kb = BTreeSet::new();
     // The plan template holds `steps` once (R022): the step nodes move into
@@ -918,11 +651,9 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
                 .into_iter()
                 .zip(&infos)
                 .filter_map(|(n, info)| n.map(|n| (n, info)))
-                .map(|(n, info)| {
-                    backchain(n, info, &texts[&input.steps[info.index].action], &info.args)
-                })
+                .map(|(n, info)| arrange::backchain(n, info))
                 .collect(),
-            StepsMode::Parallel => vec![parallel(&nodes, &infos)],
+            StepsMode::Parallel => vec![arrange::parallel(&nodes, &infos)],
         }
     };
     let root = match template {
@@ -979,23 +710,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
         trees,
         nodes,
         steps: infos,
-        objects: input
-            .pix
-            .object_names
-            .iter()
-            .zip(&input.pix.object_types)
-            .map(|(n, t)| (n.clone(), input.dix.types.display(t)))
-            .collect(),
-        init: input
-            .problem
-            .init
-            .iter()
-            .filter_map(|f| match f {
-                btc_pddl::ast::InitFact::Atom { atom } => Some(atom.to_string()),
-                btc_pddl::ast::InitFact::Value { .. } => None,
-            })
-            .collect(),
-        goal: input.problem.goal.as_ref().map(|g| g.to_string()),
+        world: WorldModel::from_checked(input.domain, input.dix, input.problem, input.pix),
     })
 }
 
@@ -1092,7 +807,7 @@ fn node_models(decls: &Decls, used: &BTreeSet<String>) -> Vec<NodeModel> {
                         ty: p.ty.text.clone(),
                     })
                     .collect(),
-                formula: n.formula.as_ref().map(|f| f.to_string()),
+                formula: n.formula.as_ref().map(Formula::from_ast),
             })
         })
         .collect()
@@ -1105,162 +820,4 @@ fn kb_decl(id: &str) -> Option<NodeDecl> {
         Item::Node(n) if n.name.text == id => Some(n),
         _ => None,
     })
-}
-
-/// `Fallback(effects already hold, Sequence(preconditions hold, step))`.
-fn backchain(step: Node, info: &StepInfo, t: &ActionTexts, args: &[String]) -> Node {
-    let Some(done) = t.done.as_ref().map(|d| d.ground(args)) else {
-        return step; // no plain effect to test: always run it
-    };
-    let mut seq = Vec::new();
-    if let Some(pre) = &info.pre_start {
-        seq.push(kb_leaf(
-            LeafKind::Condition,
-            "KbHolds",
-            "formula",
-            pre.clone(),
-            Some(format!("step {} ready?", info.index + 1)),
-        ));
-    }
-    seq.push(step);
-    Node::Control {
-        control: ControlKind::Fallback,
-        name: Some(format!("step {} {}", info.index + 1, info.display())),
-        children: vec![
-            kb_leaf(
-                LeafKind::Condition,
-                "KbHolds",
-                "formula",
-                done,
-                Some(format!("step {} done?", info.index + 1)),
-            ),
-            Node::Control {
-                control: ControlKind::Sequence,
-                name: None,
-                children: seq,
-            },
-        ],
-    }
-}
-
-/// Orders steps by causal links and threats: step j comes after step i
-/// (i < j) when i's effects touch j's conditions or effects, or j's effects
-/// touch i's conditions. Steps whose conditions or effects are not plain
-/// conjunctions are ordered after everything before them.
-fn order_steps(input: &LowerInput, texts: &BTreeMap<usize, ActionTexts>, infos: &mut [StepInfo]) {
-    type Lit = (bool, String, Vec<String>);
-    let ground = |lits: &[(bool, String, Vec<Slot>)], args: &[String]| -> Vec<Lit> {
-        lits.iter()
-            .map(|(p, pred, slots)| {
-                let a = slots
-                    .iter()
-                    .map(|s| match s {
-                        Slot::Param(i) => args[*i].clone(),
-                        Slot::Const(c) => c.clone(),
-                    })
-                    .collect();
-                (*p, pred.clone(), a)
-            })
-            .collect()
-    };
-    let per_step: Vec<Option<(Vec<Lit>, Vec<Lit>)>> = infos
-        .iter()
-        .map(|info| {
-            let t = &texts[&input.steps[info.index].action];
-            t.literals
-                .as_ref()
-                .map(|l| (ground(&l.pre, &info.args), ground(&l.eff, &info.args)))
-        })
-        .collect();
-    let touches = |a: &[Lit], b: &[Lit]| {
-        a.iter()
-            .any(|(_, p, x)| b.iter().any(|(_, q, y)| p == q && x == y))
-    };
-    for j in 0..infos.len() {
-        if infos[j].skipped {
-            continue;
-        }
-        let mut after = Vec::new();
-        for i in 0..j {
-            if infos[i].skipped {
-                continue;
-            }
-            let dep = match (&per_step[i], &per_step[j]) {
-                (Some((pi, ei)), Some((pj, ej))) => {
-                    touches(ei, pj) || touches(ei, ej) || touches(ej, pi)
-                }
-                _ => true,
-            };
-            if dep {
-                after.push(i);
-            }
-        }
-        infos[j].after = after;
-    }
-}
-
-/// Independent chains of steps under one Parallel node; a step that waits
-/// for a step of another chain starts with `WaitForStep`.
-fn parallel(step_nodes: &[Option<Node>], infos: &[StepInfo]) -> Node {
-    // Transitive "must precede" closure over the `after` lists.
-    let n = infos.len();
-    let mut precedes: Vec<BTreeSet<usize>> = vec![BTreeSet::new(); n];
-    for j in 0..n {
-        let mut set = BTreeSet::new();
-        for &i in &infos[j].after {
-            set.insert(i);
-            set.extend(precedes[i].iter().copied());
-        }
-        precedes[j] = set;
-    }
-    let mut chains: Vec<Vec<usize>> = Vec::new();
-    for j in (0..n).filter(|&j| step_nodes[j].is_some()) {
-        // Extend a chain whose last step must precede j anyway.
-        match chains
-            .iter_mut()
-            .find(|c| precedes[j].contains(c.last().expect("non-empty")))
-        {
-            Some(c) => c.push(j),
-            None => chains.push(vec![j]),
-        }
-    }
-    let branches: Vec<Node> = chains
-        .iter()
-        .map(|chain| {
-            let mut seq = Vec::new();
-            for (k, &j) in chain.iter().enumerate() {
-                let prev = if k > 0 { Some(chain[k - 1]) } else { None };
-                // Direct predecessors outside this chain (others are implied).
-                for &i in &infos[j].after {
-                    let implied = prev.is_some_and(|p| p == i || precedes[p].contains(&i));
-                    if !implied && !chain[..k].contains(&i) {
-                        seq.push(Node::Leaf {
-                            leaf: LeafKind::Action,
-                            id: "WaitForStep".into(),
-                            name: Some(format!("wait for step {}", i + 1)),
-                            ports: vec![Port {
-                                name: "step".into(),
-                                value: PortValue::Int(i as i64 + 1),
-                            }],
-                        });
-                    }
-                }
-                seq.push(step_nodes[j].clone().expect("filtered"));
-            }
-            Node::Control {
-                control: ControlKind::Sequence,
-                name: None,
-                children: seq,
-            }
-        })
-        .collect();
-    let count = branches.len().max(1) as u32;
-    Node::Control {
-        control: ControlKind::Parallel {
-            success: count,
-            failure: 1,
-        },
-        name: Some("plan".into()),
-        children: branches,
-    }
 }

@@ -12,6 +12,8 @@ use btc_ir::{
     TreeIr, IR_VERSION,
 };
 use btc_lang::db::{compile, CompileJob, Database};
+use btc_pddl::logic::{name, Atom, Effect, Formula, InitFact, Signature, Term, TypedVar};
+use btc_pddl::world::{ObjectDecl, TypeDecl, WorldModel};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -279,7 +281,34 @@ fn leaf(kind: LeafKind, id: &str, name: Option<&str>, ports: Vec<Port>) -> Node 
     }
 }
 
-fn model(id: &str, kind: LeafKind, ports: &[&str], formula: Option<&str>) -> NodeModel {
+/// `(pred args...)` over objects (or `?variables`), whatever their names:
+/// hostile names cannot be written as PDDL text, so values are built.
+fn atom(pred: &str, args: &[&str]) -> Atom {
+    Atom {
+        pred: name(pred),
+        args: args
+            .iter()
+            .map(|a| match a.strip_prefix('?') {
+                Some(v) => Term::Var(name(v)),
+                None => Term::Obj(name(a)),
+            })
+            .collect(),
+    }
+}
+
+fn fact(pred: &str, args: &[&str]) -> Formula {
+    Formula::Atom(atom(pred, args))
+}
+
+/// `?o - th"ing`
+fn thing_var() -> Vec<TypedVar> {
+    vec![TypedVar {
+        name: name("o"),
+        types: vec![name("th\"ing")],
+    }]
+}
+
+fn model(id: &str, kind: LeafKind, ports: &[&str], formula: Option<Formula>) -> NodeModel {
     NodeModel {
         id: id.into(),
         kind,
@@ -291,11 +320,11 @@ fn model(id: &str, kind: LeafKind, ports: &[&str], formula: Option<&str>) -> Nod
                 ty: "string".into(),
             })
             .collect(),
-        formula: formula.map(Into::into),
+        formula,
     }
 }
 
-fn step(index: usize, args: &[&str], eff_end: String) -> StepInfo {
+fn step(index: usize, args: &[&str], eff_end: Effect) -> StepInfo {
     StepInfo {
         index,
         line: index as u32 + 1,
@@ -305,11 +334,11 @@ fn step(index: usize, args: &[&str], eff_end: String) -> StepInfo {
         duration: Some(1.0),
         rule: Some("rule \"\"\"x".into()),
         skipped: false,
-        pre_start: Some(format!("(at {} {})", args[0], args[1])),
+        pre_start: Some(fact("at", &args[..2])),
         pre_over_all: None,
         pre_end: None,
         // Step 2 starts by deleting the fact step 1 added.
-        eff_start: (index == 1).then(|| format!("(not (at {} {}))", args[0], args[1])),
+        eff_start: (index == 1).then(|| Effect::Delete(atom("at", &args[..2]))),
         eff_end: Some(eff_end),
         after: Vec::new(),
     }
@@ -336,7 +365,7 @@ fn hostile_ir() -> TreeIr {
         "At?\"Where\n",
         Condition,
         &["who", "where"],
-        Some("(at ?who ?where)"),
+        Some(fact("at", &["?who", "?where"])),
     ));
     // A subtree called with hostile arguments, interpolated into a name.
     let tree = TreeDef {
@@ -388,7 +417,10 @@ fn hostile_ir() -> TreeIr {
         Condition,
         "KbHolds",
         Some("kb \"holds\"\n"),
-        vec![port("formula", text(&format!("(at {OBJ_A} {OBJ_B})")))],
+        vec![port(
+            "formula",
+            PortValue::Formula(fact("at", &[OBJ_A, OBJ_B])),
+        )],
     ));
     children.push(Node::Step {
         step: 1,
@@ -430,23 +462,61 @@ fn hostile_ir() -> TreeIr {
         trees: vec![tree],
         nodes,
         steps: vec![
-            step(0, &[OBJ_A, OBJ_B, OBJ_C], format!("(at {OBJ_A} {OBJ_C})")),
+            step(
+                0,
+                &[OBJ_A, OBJ_B, OBJ_C],
+                Effect::Add(atom("at", &[OBJ_A, OBJ_C])),
+            ),
             step(
                 1,
                 &[OBJ_A, OBJ_C, OBJ_B],
-                format!("(and (at {OBJ_A} {OBJ_B}) (forall (?o - th\"ing) (seen ?o)))"),
+                Effect::And(vec![
+                    Effect::Add(atom("at", &[OBJ_A, OBJ_B])),
+                    Effect::Forall(thing_var(), Box::new(Effect::Add(atom("seen", &["?o"])))),
+                ]),
             ),
         ],
+        world: hostile_world(),
+    }
+}
+
+fn hostile_world() -> WorldModel {
+    let sig = |n: &str, arity: usize| Signature {
+        name: name(n),
+        params: (0..arity)
+            .map(|i| TypedVar {
+                name: name(&format!("x{i}")),
+                types: Vec::new(),
+            })
+            .collect(),
+    };
+    let object = |n: &str, t: &str| ObjectDecl {
+        name: name(n),
+        types: vec![name(t)],
+    };
+    WorldModel {
+        types: ["th\"ing", "pla'''ce"]
+            .iter()
+            .map(|t| TypeDecl {
+                name: name(t),
+                parents: Vec::new(),
+            })
+            .collect(),
         objects: vec![
-            (OBJ_A.into(), "th\"ing".into()),
-            (OBJ_B.into(), "th\"ing".into()),
-            (OBJ_C.into(), "pla'''ce".into()),
+            object(OBJ_A, "th\"ing"),
+            object(OBJ_B, "th\"ing"),
+            object(OBJ_C, "pla'''ce"),
         ],
-        init: vec![format!("(at {OBJ_A} {OBJ_B})")],
-        goal: Some(format!(
-            "(and (at {OBJ_A} {OBJ_B}) (done {OBJ_B}) (forall (?o - th\"ing) (seen ?o)) \
-             (not (at {OBJ_A} {OBJ_C})))"
-        )),
+        predicates: vec![sig("at", 2), sig("done", 1), sig("seen", 1)],
+        functions: Vec::new(),
+        derived: Vec::new(),
+        init: vec![InitFact::Atom(atom("at", &[OBJ_A, OBJ_B]))],
+        goal: Some(Formula::And(vec![
+            fact("at", &[OBJ_A, OBJ_B]),
+            fact("done", &[OBJ_B]),
+            Formula::Forall(thing_var(), Box::new(fact("seen", &["?o"]))),
+            Formula::Not(Box::new(fact("at", &[OBJ_A, OBJ_C]))),
+        ])),
     }
 }
 
@@ -504,7 +574,13 @@ fn hostile_names_stay_strings() {
         let got: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
         let objects: Vec<(String, String)> =
             serde_json::from_value(got["objects"].clone()).unwrap();
-        assert_eq!(objects, ir.objects);
+        let want: Vec<(String, String)> = ir
+            .world
+            .objects
+            .iter()
+            .map(|o| (o.name.to_string(), o.types[0].to_string()))
+            .collect();
+        assert_eq!(objects, want);
         let facts: Vec<Vec<String>> = serde_json::from_value(got["facts"].clone()).unwrap();
         assert_eq!(
             facts,
@@ -589,7 +665,9 @@ assert holds("(and (>= (total-cost) 3) (< (total-cost) (+ 1 3)) (= (total-cost) 
 kb.apply(p("(decrease (total-cost) (* 2 (total-cost)))"))
 assert holds("(= (total-cost) -3)")
 kb.reset()
-assert not holds("(counted i1)") and holds("(free r1)") and kb.fluents == {}
+# The problem's initial values come back (the IR carries them).
+assert not holds("(counted i1)") and holds("(free r1)")
+assert kb.fluents == {("total-cost",): 0.0}
 assert not m.goal_reached(kb)
 print("evaluator ok")
 "#;

@@ -332,6 +332,7 @@ pub mod codes {
         X_TOO_DEEP = "X007", "a tree nested deeper than the runtime runs";
         X_REPLAN_UNSOLVABLE = "X008", "a goal that replanning cannot reach after a fault";
         X_REPLAN_LIMIT = "X009", "a closed loop that stopped at its replan or tick limit";
+        X_WORLD = "X010", "a JSON IR whose world is missing or does not fit together";
         // ARIAC trials (btc trial)
         TRIAL_SYNTAX = "T001", "a trial file that is not YAML btc reads";
         TRIAL_MISSING = "T002", "a trial field the ARIAC 2023 format requires is missing";

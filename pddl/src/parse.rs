@@ -170,8 +170,17 @@ impl Parser {
 
     fn document(&mut self, forest: &[Sexp], whole: Span) -> Option<Document> {
         let mut doc = None;
+        // Things outside any `(define ...)`: the first is reported, the rest
+        // counted (a file of a million stray words is one problem).
+        let mut stray = 0usize;
         for s in forest {
             let define = s.as_list().filter(|l| l.head() == Some("define"));
+            if define.is_none() {
+                stray += 1;
+                if stray > 1 {
+                    continue;
+                }
+            }
             match (define, &doc) {
                 (Some(l), None) => doc = self.define(l),
                 (Some(l), Some(_)) => {
@@ -187,6 +196,14 @@ impl Parser {
                     self.error(codes::NOT_A_DEFINE, s.span(), msg);
                 }
             }
+        }
+        if stray > 1 {
+            let last = forest.last().map_or(whole, Sexp::span);
+            self.error(
+                codes::NOT_A_DEFINE,
+                last,
+                format!("and {} more things outside `(define ...)`", stray - 1),
+            );
         }
         if doc.is_none() && forest.is_empty() {
             self.error(

@@ -206,3 +206,18 @@ fn empty_and_blank_inputs_are_reported() {
         assert!(has_errors(&diags), "{t:?}: no error");
     }
 }
+
+/// A file of stray words costs a bounded number of diagnostics: the lexer
+/// keeps 100 bad words and counts the rest, the parser reports the first
+/// thing outside `(define ...)` and counts the rest.
+#[test]
+fn stray_words_make_a_bounded_number_of_diagnostics() {
+    for text in ["\0 ".repeat(200_000), "word ".repeat(200_000)] {
+        let (_, diags) = btc_pddl::parse_document(&text, 0);
+        assert!(diags.len() <= 110, "{}", diags.len());
+        assert!(
+            diags.iter().any(|d| d.message.contains("more")),
+            "{diags:#?}"
+        );
+    }
+}

@@ -63,6 +63,7 @@ impl Value {
             PortValue::Float(f) => Value::Float(*f),
             PortValue::Bool(b) => Value::Bool(*b),
             PortValue::Param(p) => Value::Text(format!("{{{p}}}").into()),
+            PortValue::Formula(_) | PortValue::Effect(_) => Value::Text(v.to_text().into()),
         }
     }
 
@@ -419,11 +420,11 @@ impl<'w> Engine<'w> {
                 ..StepRt::default()
             };
             if !s.skipped {
-                rt.pre_start = self.kb_formula_text(s.pre_start.as_deref(), &rt.label)?;
-                rt.pre_over_all = self.kb_formula_text(s.pre_over_all.as_deref(), &rt.label)?;
-                rt.pre_end = self.kb_formula_text(s.pre_end.as_deref(), &rt.label)?;
-                rt.eff_start = self.kb_effect_text(s.eff_start.as_deref(), &rt.label)?;
-                rt.eff_end = self.kb_effect_text(s.eff_end.as_deref(), &rt.label)?;
+                rt.pre_start = self.kb_formula(s.pre_start.as_ref(), &rt.label)?;
+                rt.pre_over_all = self.kb_formula(s.pre_over_all.as_ref(), &rt.label)?;
+                rt.pre_end = self.kb_formula(s.pre_end.as_ref(), &rt.label)?;
+                rt.eff_start = self.kb_effect(s.eff_start.as_ref(), &rt.label)?;
+                rt.eff_end = self.kb_effect(s.eff_end.as_ref(), &rt.label)?;
             }
             self.steps.push(rt);
         }
@@ -462,32 +463,6 @@ impl<'w> Engine<'w> {
                 format!("{what}: `{e}` is not an effect of this problem: {m}"),
             )
         })
-    }
-
-    /// [`Engine::kb_formula`] of PDDL text (the IR's version 1 strings).
-    fn kb_formula_text(
-        &mut self,
-        text: Option<&str>,
-        what: &str,
-    ) -> Result<Option<FormulaId>, LoadError> {
-        let Some(t) = text.filter(|t| !t.trim().is_empty()) else {
-            return Ok(None);
-        };
-        let f = decoded(btc_pddl::logic::decode::formula(t), t, what, "a condition")?;
-        self.kb_formula(Some(&f), what)
-    }
-
-    /// [`Engine::kb_effect`] of PDDL text.
-    fn kb_effect_text(
-        &mut self,
-        text: Option<&str>,
-        what: &str,
-    ) -> Result<Option<EffectId>, LoadError> {
-        let Some(t) = text.filter(|t| !t.trim().is_empty()) else {
-            return Ok(None);
-        };
-        let e = decoded(btc_pddl::logic::decode::effect(t), t, what, "an effect")?;
-        self.kb_effect(Some(&e), what)
     }
 
     fn new_slot(&mut self, name: String, v: Value) -> u32 {
@@ -1087,8 +1062,9 @@ impl<'w> Engine<'w> {
             .iter()
             .map(|&p| {
                 let port = &self.ports[p as usize];
+                // PDDL names are case-insensitive; a port's text keeps its case.
                 let v = self.value(&port.src).text();
-                kb.object(&v).ok_or_else(|| {
+                kb.object(&v.to_lowercase()).ok_or_else(|| {
                     format!(
                         "port `{}` holds `{v}`, which is not an object of this problem",
                         port.name
@@ -1365,14 +1341,17 @@ impl<'w> Engine<'w> {
     }
 }
 
-/// A decoded formula or effect, or X005 naming what it should have been.
-fn decoded<T>(r: Result<T, String>, text: &str, what: &str, kind: &str) -> Result<T, LoadError> {
-    r.map_err(|m| {
-        LoadError::new(
-            codes::X_KB,
-            format!("{what}: `{text}` is not {kind} of this problem: {m}"),
-        )
-    })
+/// X005 for a KB node whose port holds something other than PDDL.
+fn not_pddl(n: &SNode, id: &str, key: &str, v: &PortValue, what: &str) -> LoadError {
+    LoadError::new(
+        codes::X_KB,
+        format!(
+            "`{id}`: port `{key}` holds `{}`, which is not a PDDL {what} value",
+            v.to_text()
+        ),
+    )
+    .at_opt(n.at)
+    .hint("trees written by `btc compile` carry PDDL values here; check the file was not edited by hand")
 }
 
 fn no_kb(what: &str) -> LoadError {
@@ -1524,14 +1503,14 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
                 let label = format!("`{}`", self.e.steps[*k].label);
                 if let Some(f) = self
                     .e
-                    .kb_effect_text(start_effect.as_deref(), &label)
+                    .kb_effect(start_effect.as_ref(), &label)
                     .map_err(|e| e.at_opt(n.at))?
                 {
                     self.e.steps[*k].eff_start = Some(f);
                 }
                 if let Some(f) = self
                     .e
-                    .kb_effect_text(end_effect.as_deref(), &label)
+                    .kb_effect(end_effect.as_ref(), &label)
                     .map_err(|e| e.at_opt(n.at))?
                 {
                     self.e.steps[*k].eff_end = Some(f);
@@ -1736,6 +1715,28 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
         Ok((start, self.e.ports.len() as u32))
     }
 
+    /// A KB node's PDDL port: it must be written out.
+    fn kb_port<'p>(
+        &self,
+        n: &SNode,
+        ports: &'p [(String, PortValue)],
+        key: &str,
+    ) -> Result<&'p PortValue, LoadError> {
+        match ports.iter().find(|(k, _)| k == key) {
+            Some((_, PortValue::Param(p))) => Err(self.err(
+                codes::X_BAD_PORT,
+                n,
+                format!("port `{key}` of `{}` must be written out, not read from the blackboard entry `{p}`", default_name(&n.kind)),
+            )),
+            Some((_, v)) => Ok(v),
+            None => Err(self.err(
+                codes::X_BAD_PORT,
+                n,
+                format!("`{}` needs the port `{key}`", default_name(&n.kind)),
+            )),
+        }
+    }
+
     fn const_text(
         &self,
         n: &SNode,
@@ -1860,24 +1861,24 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
                 });
             }
             "KbHolds" => {
-                let t = self.const_text(n, ports, "formula", true)?;
-                let f = self
-                    .e
-                    .kb_formula_text(t.as_deref(), &what)
-                    .map_err(|e| e.at_opt(n.at))?;
+                let f = match self.kb_port(n, ports, "formula")? {
+                    PortValue::Formula(f) => self.e.kb_formula(Some(f), &what),
+                    other => Err(not_pddl(n, id, "formula", other, "condition")),
+                }
+                .map_err(|e| e.at_opt(n.at))?;
                 return match f {
                     Some(f) => Ok(Op::KbHolds(f)),
                     None => Ok(Op::AlwaysSuccess),
                 };
             }
             "KbApply" => {
-                let t = self.const_text(n, ports, "effect", true)?;
-                let f = self
-                    .e
-                    .kb_effect_text(t.as_deref(), &what)
-                    .map_err(|e| e.at_opt(n.at))?;
-                return match f {
-                    Some(f) => Ok(Op::KbApply(f)),
+                let e = match self.kb_port(n, ports, "effect")? {
+                    PortValue::Effect(e) => self.e.kb_effect(Some(e), &what),
+                    other => Err(not_pddl(n, id, "effect", other, "effect")),
+                }
+                .map_err(|e| e.at_opt(n.at))?;
+                return match e {
+                    Some(e) => Ok(Op::KbApply(e)),
                     None => Ok(Op::AlwaysSuccess),
                 };
             }
@@ -1914,20 +1915,7 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
         let range = self.bind_ports(n, ports, &types, scope)?;
         Ok(match kind {
             LeafKind::Condition => {
-                let formula = match model.and_then(|m| m.formula.as_deref()) {
-                    Some(text) => {
-                        let what = format!("the condition `{id}`");
-                        let f = decoded(
-                            btc_pddl::logic::decode::formula(text),
-                            text,
-                            &what,
-                            "a condition",
-                        )
-                        .map_err(|e| e.at_opt(n.at))?;
-                        Some(f)
-                    }
-                    None => None,
-                };
+                let formula = model.and_then(|m| m.formula.clone());
                 let c = self.e.conds.len() as u32;
                 let (compiled, slot_ports) = match &formula {
                     Some(f) => {

@@ -3,10 +3,11 @@
 //! world (a PDDL knowledge base), with an optional queued robot controller
 //! and injected ARIAC faults. Nothing here prints; `btc run` does.
 //!
-//! Loading: [`spec::TreeDoc`] from the IR ([`spec::TreeDoc::from_ir`]),
-//! JSON ([`spec::TreeDoc::from_json`]) or XML ([`xml::parse`]); then
-//! [`Engine::build`] compiles it into a flat arena and [`Engine::run`]
-//! ticks it.
+//! Loading: [`spec::TreeDoc`] from the IR ([`spec::TreeDoc::from_ir`]) or
+//! XML ([`xml::parse`]), or a tree file of either kind ([`load_tree`]);
+//! then [`Engine::build`] compiles it into a flat arena and
+//! [`Engine::run`] ticks it. A JSON IR carries its world; a BT.CPP XML
+//! tree runs in the world of PDDL files.
 
 pub mod controller;
 pub mod engine;
@@ -65,14 +66,41 @@ impl<'w> Engine<'w> {
     }
 }
 
+/// A tree file as read.
+#[derive(Debug)]
+#[allow(clippy::large_enum_variant)] // one per run
+pub enum Loaded {
+    /// BT.CPP XML: its world comes from PDDL files.
+    Xml(TreeDoc),
+    /// btc's JSON IR, with the world it runs in.
+    Ir(btc_ir::TreeIr),
+    /// A version-1 JSON IR: no world of its own; the PDDL files it names.
+    IrV1(btc_ir::json::V1),
+}
+
 /// Reads a tree file: BT.CPP XML when it starts with `<`, btc's JSON IR
-/// when it starts with `{`. The IR comes back too (it names its problem).
-pub fn load_tree(text: &str) -> Result<(TreeDoc, Option<btc_ir::TreeIr>), LoadError> {
+/// (any version) when it starts with `{`.
+pub fn load_tree(text: &str) -> Result<Loaded, LoadError> {
+    use btc_pddl::diagnostic::codes;
     match text.trim_start().chars().next() {
-        Some('<') => xml::parse(text).map(|d| (d, None)),
-        Some('{') => TreeDoc::from_json(text).map(|(d, ir)| (d, Some(ir))),
+        Some('<') => xml::parse(text).map(Loaded::Xml),
+        Some('{') => match btc_ir::json::decode(text) {
+            Ok(btc_ir::json::IrFile::Current(ir)) => Ok(Loaded::Ir(ir)),
+            Ok(btc_ir::json::IrFile::V1(v1)) => Ok(Loaded::IrV1(v1)),
+            Err(e) => {
+                let mut err = LoadError::new(
+                    codes::X_TREE_SYNTAX,
+                    format!("this is not btc's JSON tree IR: {}", e.message),
+                )
+                .hint("write it with `btc compile RULES --plan PLAN --emit json`");
+                if e.line > 0 {
+                    err = err.at(spec::line_col_offset(text, e.line, e.column));
+                }
+                Err(err)
+            }
+        },
         _ => Err(LoadError::new(
-            btc_pddl::diagnostic::codes::X_TREE_SYNTAX,
+            codes::X_TREE_SYNTAX,
             "this is neither BT.CPP XML nor btc's JSON tree IR",
         )
         .at(0)

@@ -1,10 +1,8 @@
 //! A loaded tree before compilation: what the JSON IR and the XML loader
 //! both produce, so the two run through one builder (and give one trace).
 
-use crate::error::LoadError;
 use btc_ir::{ControlKind, DecoratorKind};
 use btc_ir::{LeafKind, Node, NodeModel, PortValue, StepInfo, TreeIr};
-use btc_pddl::diagnostic::codes;
 
 /// What a node does. Thresholds and counts are BT.CPP's: `-1` means "all
 /// children" (Parallel) or "forever" (Retry, Repeat).
@@ -36,8 +34,8 @@ pub enum Kind {
     /// XML `KbStep` attributes) take the place of the step table's.
     Step {
         step: usize,
-        start_effect: Option<String>,
-        end_effect: Option<String>,
+        start_effect: Option<btc_pddl::logic::Effect>,
+        end_effect: Option<btc_pddl::logic::Effect>,
     },
     /// A leaf: built in, a KB node, or a node of the models.
     Leaf {
@@ -101,25 +99,9 @@ impl TreeDoc {
             actions: Vec::new(),
         }
     }
-
-    /// The document for a JSON text: btc's IR (`btc compile --emit json`).
-    pub fn from_json(text: &str) -> Result<(TreeDoc, TreeIr), LoadError> {
-        match serde_json::from_str::<TreeIr>(text) {
-            Ok(ir) => Ok((TreeDoc::from_ir(&ir), ir)),
-            Err(e) => {
-                let offset = line_col_offset(text, e.line(), e.column());
-                Err(LoadError::new(
-                    codes::X_TREE_SYNTAX,
-                    format!("this is not btc's JSON tree IR: {e}"),
-                )
-                .at(offset)
-                .hint("write it with `btc compile RULES --plan PLAN --emit json`"))
-            }
-        }
-    }
 }
 
-fn line_col_offset(text: &str, line: usize, col: usize) -> usize {
+pub(crate) fn line_col_offset(text: &str, line: usize, col: usize) -> usize {
     let start: usize = text
         .split_inclusive('\n')
         .take(line.saturating_sub(1))

@@ -1,13 +1,16 @@
 //! BehaviorTree.CPP v4 XML to a [`TreeDoc`]: `<root>`, `<BehaviorTree ID>`
 //! elements, `<TreeNodesModel>` (leaf kinds, port types, and the formulas
 //! btc writes as `description="holds when ..."`), and btc's `KbStep`.
-//! The reader is iterative: depth is checked, never the stack.
+//! The reader is iterative: depth is checked, never the stack. The PDDL
+//! text btc writes into attributes (`KbStep` effects, `KbHolds` formulas,
+//! `KbApply` effects, model formulas) is decoded here, once.
 
 use crate::engine::MAX_DEPTH;
 use crate::error::LoadError;
 use crate::spec::{Kind, SNode, TreeDoc};
 use btc_ir::{LeafKind, NodeModel, PortDirection, PortModel, PortValue};
 use btc_pddl::diagnostic::codes;
+use btc_pddl::logic::decode;
 use quick_xml::events::{BytesStart, Event};
 use quick_xml::Reader;
 
@@ -144,8 +147,8 @@ fn node_of(mut e: Elem) -> Result<SNode, LoadError> {
                 })?;
             Kind::Step {
                 step: step - 1,
-                start_effect: e.get("start_effect").map(str::to_owned),
-                end_effect: e.get("end_effect").map(str::to_owned),
+                start_effect: pddl(&e, "start_effect", decode::effect, "an effect")?,
+                end_effect: pddl(&e, "end_effect", decode::effect, "an effect")?,
             }
         }
         // Groot 1 spelling: <Action ID="MoveTo" .../>.
@@ -169,11 +172,15 @@ fn node_of(mut e: Elem) -> Result<SNode, LoadError> {
                 ports: ports(&mut e, &["ID"]),
             }
         }
-        _ => Kind::Leaf {
-            id: std::mem::take(&mut e.name),
-            kind: None,
-            ports: ports(&mut e, &[]),
-        },
+        _ => {
+            let mut ps = ports(&mut e, &[]);
+            kb_ports(&e, &mut ps)?;
+            Kind::Leaf {
+                id: std::mem::take(&mut e.name),
+                kind: None,
+                ports: ps,
+            }
+        }
     };
     Ok(SNode {
         kind,
@@ -181,6 +188,47 @@ fn node_of(mut e: Elem) -> Result<SNode, LoadError> {
         children: Vec::new(),
         at: Some(e.at),
     })
+}
+
+/// A PDDL attribute decoded (empty or absent: `None`); X005 when it is no
+/// PDDL `what`.
+fn pddl<T>(
+    e: &Elem,
+    key: &str,
+    decode: fn(&str) -> Result<T, String>,
+    what: &str,
+) -> Result<Option<T>, LoadError> {
+    match e.get(key).map(str::trim).filter(|t| !t.is_empty()) {
+        None => Ok(None),
+        Some(t) => decode(t)
+            .map(Some)
+            .map_err(|m| bad_pddl(e, key, t, what, &m)),
+    }
+}
+
+fn bad_pddl(e: &Elem, key: &str, text: &str, what: &str, why: &str) -> LoadError {
+    LoadError::new(
+        codes::X_KB,
+        format!("<{}>: `{key}=\"{text}\"` is not {what}: {why}", e.name),
+    )
+    .at(e.at)
+}
+
+/// `KbHolds`' formula and `KbApply`'s effect, written out, as PDDL values.
+fn kb_ports(e: &Elem, ports: &mut [(String, PortValue)]) -> Result<(), LoadError> {
+    for (k, v) in ports {
+        let PortValue::Text(t) = v else { continue };
+        *v = match (e.name.as_str(), k.as_str()) {
+            ("KbHolds", "formula") => PortValue::Formula(
+                decode::formula(t).map_err(|m| bad_pddl(e, k, t, "a PDDL condition", &m))?,
+            ),
+            ("KbApply", "effect") => PortValue::Effect(
+                decode::effect(t).map_err(|m| bad_pddl(e, k, t, "a PDDL effect", &m))?,
+            ),
+            _ => continue,
+        };
+    }
+    Ok(())
 }
 
 fn model_of(e: &Elem, kind: LeafKind) -> Result<NodeModel, LoadError> {
@@ -191,19 +239,21 @@ fn model_of(e: &Elem, kind: LeafKind) -> Result<NodeModel, LoadError> {
         )
         .at(e.at)
     })?;
-    let formula = e
+    let formula = match e
         .get("description")
         .and_then(|d| d.strip_prefix("holds when "))
-        .map(str::to_owned);
+    {
+        Some(t) if kind == LeafKind::Condition => Some(
+            decode::formula(t)
+                .map_err(|m| bad_pddl(e, "description", t, "a PDDL condition", &m))?,
+        ),
+        _ => None,
+    };
     Ok(NodeModel {
         id: id.to_owned(),
         kind,
         ports: Vec::new(),
-        formula: if kind == LeafKind::Condition {
-            formula
-        } else {
-            None
-        },
+        formula,
     })
 }
 
@@ -463,7 +513,10 @@ mod tests {
         let d = parse(text).unwrap();
         let m = d.model("Ok").unwrap();
         assert_eq!(m.kind, LeafKind::Condition);
-        assert_eq!(m.formula.as_deref(), Some("(ok ?robot)"));
+        assert_eq!(
+            m.formula.as_ref().map(|f| f.to_string()).as_deref(),
+            Some("(ok ?robot)")
+        );
         assert_eq!(m.ports[0].ty, "int");
     }
 }

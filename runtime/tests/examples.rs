@@ -115,3 +115,15 @@ fn xml_steps_check_the_domain_preconditions_like_the_ir() {
     );
     assert_eq!(runs[0], runs[1]);
 }
+
+#[test]
+fn the_ir_round_trips_through_its_json() {
+    for name in EXAMPLES {
+        let ex = example(name);
+        let text = serde_json::to_string_pretty(&ex.ir).unwrap();
+        match btc_ir::json::decode(&text) {
+            Ok(btc_ir::json::IrFile::Current(ir)) => assert_eq!(ir, ex.ir, "{name}"),
+            other => panic!("{name}: {other:?}"),
+        }
+    }
+}

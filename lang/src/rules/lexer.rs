@@ -252,10 +252,16 @@ pub fn lex(text: &str, file: FileId) -> Lexed {
                     if n == 1 { "" } else { "s" }
                 ),
             };
+            let reported = !errors.full();
             errors.push(
                 &mut out.diagnostics,
                 Diagnostic::error(codes::R_SYNTAX, span(start, i), message),
             );
+            if !reported {
+                // Past the cap a bad run leaves no token either: the parser
+                // has enough errors to report, and memory stays bounded.
+                continue;
+            }
             Tok::Error(ch)
         };
         if !matches!(tok, Tok::Error(_)) {

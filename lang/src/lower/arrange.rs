@@ -1,0 +1,178 @@
+//! How the plan's steps are put together: `steps backchained` and `steps
+//! parallel` (plain `steps` is the steps in order). Both read each step's
+//! ground conditions and effects from its [`StepInfo`], so a rule's
+//! `effect` orders and guards steps exactly as it changes the KB.
+
+use btc_ir::*;
+use btc_pddl::logic::{Effect, Formula, Literal};
+use std::collections::BTreeSet;
+
+/// A KB leaf: `KbHolds(formula)` or `KbApply(effect)`.
+pub(super) fn kb_holds(f: Formula, name: Option<String>) -> Node {
+    Node::Leaf {
+        leaf: LeafKind::Condition,
+        id: "KbHolds".into(),
+        name,
+        ports: vec![Port {
+            name: "formula".into(),
+            value: PortValue::Formula(f),
+        }],
+    }
+}
+
+/// A step's effects, start and end, as one.
+fn step_effect(info: &StepInfo) -> Option<Effect> {
+    Effect::conjunction(
+        info.eff_start
+            .iter()
+            .chain(&info.eff_end)
+            .cloned()
+            .collect(),
+    )
+}
+
+/// `Fallback(effects already hold, Sequence(preconditions hold, step))`.
+pub(super) fn backchain(step: Node, info: &StepInfo) -> Node {
+    let done = step_effect(info)
+        .and_then(|e| e.outcome())
+        .filter(|l| !l.is_empty())
+        .and_then(|l| Formula::conjunction(l.iter().map(Literal::to_formula).collect()));
+    let Some(done) = done else {
+        return step; // no plain effect to test: always run it
+    };
+    let mut seq = Vec::new();
+    if let Some(pre) = &info.pre_start {
+        seq.push(kb_holds(
+            pre.clone(),
+            Some(format!("step {} ready?", info.index + 1)),
+        ));
+    }
+    seq.push(step);
+    Node::Control {
+        control: ControlKind::Fallback,
+        name: Some(format!("step {} {}", info.index + 1, info.display())),
+        children: vec![
+            kb_holds(done, Some(format!("step {} done?", info.index + 1))),
+            Node::Control {
+                control: ControlKind::Sequence,
+                name: None,
+                children: seq,
+            },
+        ],
+    }
+}
+
+/// A step's conditions and effects as literals, when they are plain
+/// conjunctions; `None` otherwise (such a step is ordered conservatively).
+fn step_literals(info: &StepInfo) -> Option<(Vec<Literal>, Vec<Literal>)> {
+    let mut pre = Vec::new();
+    for f in [&info.pre_start, &info.pre_over_all, &info.pre_end]
+        .into_iter()
+        .flatten()
+    {
+        pre.extend(f.literals()?);
+    }
+    let mut eff = Vec::new();
+    for e in [&info.eff_start, &info.eff_end].into_iter().flatten() {
+        eff.extend(e.literals()?);
+    }
+    Some((pre, eff))
+}
+
+/// Orders steps by causal links and threats: step j comes after step i
+/// (i < j) when i's effects touch j's conditions or effects, or j's effects
+/// touch i's conditions. Steps whose conditions or effects are not plain
+/// conjunctions are ordered after everything before them.
+pub(super) fn order_steps(infos: &mut [StepInfo]) {
+    let per_step: Vec<Option<(Vec<Literal>, Vec<Literal>)>> =
+        infos.iter().map(step_literals).collect();
+    let touches =
+        |a: &[Literal], b: &[Literal]| a.iter().any(|x| b.iter().any(|y| x.atom == y.atom));
+    for j in 0..infos.len() {
+        if infos[j].skipped {
+            continue;
+        }
+        let mut after = Vec::new();
+        for i in 0..j {
+            if infos[i].skipped {
+                continue;
+            }
+            let dep = match (&per_step[i], &per_step[j]) {
+                (Some((pi, ei)), Some((pj, ej))) => {
+                    touches(ei, pj) || touches(ei, ej) || touches(ej, pi)
+                }
+                _ => true,
+            };
+            if dep {
+                after.push(i);
+            }
+        }
+        infos[j].after = after;
+    }
+}
+
+/// Independent chains of steps under one Parallel node; a step that waits
+/// for a step of another chain starts with `WaitForStep`.
+pub(super) fn parallel(step_nodes: &[Option<Node>], infos: &[StepInfo]) -> Node {
+    // Transitive "must precede" closure over the `after` lists.
+    let n = infos.len();
+    let mut precedes: Vec<BTreeSet<usize>> = vec![BTreeSet::new(); n];
+    for j in 0..n {
+        let mut set = BTreeSet::new();
+        for &i in &infos[j].after {
+            set.insert(i);
+            set.extend(precedes[i].iter().copied());
+        }
+        precedes[j] = set;
+    }
+    let mut chains: Vec<Vec<usize>> = Vec::new();
+    for j in (0..n).filter(|&j| step_nodes[j].is_some()) {
+        // Extend a chain whose last step must precede j anyway.
+        match chains
+            .iter_mut()
+            .find(|c| precedes[j].contains(c.last().expect("non-empty")))
+        {
+            Some(c) => c.push(j),
+            None => chains.push(vec![j]),
+        }
+    }
+    let branches: Vec<Node> = chains
+        .iter()
+        .map(|chain| {
+            let mut seq = Vec::new();
+            for (k, &j) in chain.iter().enumerate() {
+                let prev = if k > 0 { Some(chain[k - 1]) } else { None };
+                // Direct predecessors outside this chain (others are implied).
+                for &i in &infos[j].after {
+                    let implied = prev.is_some_and(|p| p == i || precedes[p].contains(&i));
+                    if !implied && !chain[..k].contains(&i) {
+                        seq.push(Node::Leaf {
+                            leaf: LeafKind::Action,
+                            id: "WaitForStep".into(),
+                            name: Some(format!("wait for step {}", i + 1)),
+                            ports: vec![Port {
+                                name: "step".into(),
+                                value: PortValue::Int(i as i64 + 1),
+                            }],
+                        });
+                    }
+                }
+                seq.push(step_nodes[j].clone().expect("filtered"));
+            }
+            Node::Control {
+                control: ControlKind::Sequence,
+                name: None,
+                children: seq,
+            }
+        })
+        .collect();
+    let count = branches.len().max(1) as u32;
+    Node::Control {
+        control: ControlKind::Parallel {
+            success: count,
+            failure: 1,
+        },
+        name: Some("plan".into()),
+        children: branches,
+    }
+}
