@@ -40,7 +40,10 @@ pub enum Format {
     Json,
 }
 
+// `defer`: a subcommand's arguments are built only when it is the one
+// run, so `btc --version` and each command do not build all the others.
 #[derive(Subcommand)]
+#[command(defer = true)]
 enum Command {
     /// Parse and check PDDL domains and problems.
     Pddl {
@@ -130,11 +133,15 @@ enum Command {
         #[arg(short = 'o', long = "output")]
         output: Option<PathBuf>,
         /// The search algorithm.
-        #[arg(long, value_enum, default_value_t = SearchArg::Gbfs)]
+        #[arg(long, value_enum, default_value_t = SearchArg::Lama)]
         search: SearchArg,
-        /// The heuristic.
+        /// The heuristic (of `gbfs` and `astar`; `lama` uses h_FF and landmarks).
         #[arg(long, value_enum, default_value_t = HeuristicArg::Ff)]
         heuristic: HeuristicArg,
+        /// `lama`: the work its restarts may spend improving the first
+        /// plan (0: stop at the first plan).
+        #[arg(long, value_name = "WORK", default_value_t = btc_planner::DEFAULT_IMPROVE)]
+        improve: u64,
         /// Give up after this many seconds.
         #[arg(long, value_name = "S")]
         timeout: Option<f64>,
@@ -148,7 +155,10 @@ enum Command {
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
 enum SearchArg {
-    /// Greedy best-first search (fast, not optimal).
+    /// LAMA: lazy greedy search with h_FF and landmarks, then restarts
+    /// with weighted A* that improve the plan (the default).
+    Lama,
+    /// Eager greedy best-first search with one heuristic (fast, not optimal).
     Gbfs,
     /// A* (optimal with `lmcut`, `max` or `blind`).
     Astar,
@@ -197,6 +207,7 @@ fn plan_options(
     search: SearchArg,
     heuristic: HeuristicArg,
     timeout: Option<f64>,
+    improve: u64,
 ) -> anyhow::Result<btc_planner::Options> {
     use btc_planner::{Algorithm, Heuristic};
     let timeout = match timeout {
@@ -208,6 +219,7 @@ fn plan_options(
     };
     Ok(btc_planner::Options {
         algorithm: match search {
+            SearchArg::Lama => Algorithm::Lama,
             SearchArg::Gbfs => Algorithm::Gbfs,
             SearchArg::Astar => Algorithm::Astar,
         },
@@ -219,6 +231,7 @@ fn plan_options(
             HeuristicArg::Lmcut => Heuristic::LmCut,
         },
         timeout,
+        improve,
     })
 }
 
@@ -275,10 +288,11 @@ fn main() -> ExitCode {
             output,
             search,
             heuristic,
+            improve,
             timeout,
             quiet,
             format,
-        } => plan_options(search, heuristic, timeout).and_then(|options| {
+        } => plan_options(search, heuristic, timeout, improve).and_then(|options| {
             plan_cmd::run(&plan_cmd::PlanArgs {
                 domain: &domain,
                 problem: &problem,

@@ -40,8 +40,19 @@ pub fn run(args: &PlanArgs) -> anyhow::Result<ExitCode> {
             return finish(&diags, &sources, args.format, None);
         }
     };
+    let base_cost = match &report.outcome {
+        Outcome::Plan(p) => p.base_cost,
+        _ => 0.0,
+    };
     let stats = serde_json::json!({
-        "heuristic": report.search.heuristic.map(|h| format!("{h:?}").to_lowercase()),
+        "heuristic": report
+            .search
+            .heuristic
+            .map_or_else(|| "ff+landmarks".to_owned(), |h| format!("{h:?}").to_lowercase()),
+        "searches": report.search.iterations,
+        "first_cost": report.search.first_cost.map(|c| base_cost + c as f64),
+        "proved_optimal": report.search.proved_optimal,
+        "work": report.search.work,
         "reachable_atoms": report.ground.reachable_atoms,
         "operators": report.ground.operators,
         "axioms": report.ground.axioms,
@@ -88,8 +99,21 @@ pub fn run(args: &PlanArgs) -> anyhow::Result<ExitCode> {
             Outcome::Unsolvable => "no plan exists".to_owned(),
             Outcome::Timeout => "time limit reached".to_owned(),
         };
+        let restarts = match (r.search.iterations, r.search.first_cost) {
+            (n, Some(c)) if n > 1 => format!(
+                "; {} searches from a first plan of cost {}{}",
+                n,
+                base_cost + c as f64,
+                if r.search.proved_optimal {
+                    ", proved optimal"
+                } else {
+                    ""
+                }
+            ),
+            _ => String::new(),
+        };
         eprintln!(
-            "{found}; {} ground actions, {} facts, {} axioms; {} expanded, {} generated; grounding {:.3} ms, search {:.3} ms",
+            "{found}{restarts}; {} ground actions, {} facts, {} axioms; {} expanded, {} generated; grounding {:.3} ms, search {:.3} ms",
             r.ground.operators,
             r.ground.facts,
             r.ground.axioms,

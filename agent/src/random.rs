@@ -125,21 +125,26 @@ fn kit_order(id: &str, agv: u8, tray: u8, kinds: &[PartKind], priority: bool, at
         id: id.into(),
         priority,
         announcement: time(at),
-        task: Task::Kitting {
-            agv,
-            tray_id: tray,
-            destination: Destination::Warehouse,
-            products: kinds
-                .iter()
-                .enumerate()
-                .map(|(q, k)| KitProduct {
-                    kind: *k,
-                    quadrant: q as u8 + 1,
-                    range: R,
-                })
-                .collect(),
-        },
+        task: kitting(agv, tray, kinds),
         range: R,
+    }
+}
+
+/// A kitting task to the warehouse with `kinds` in quadrants 1, 2, ...
+fn kitting(agv: u8, tray: u8, kinds: &[PartKind]) -> Task {
+    Task::Kitting {
+        agv,
+        tray_id: tray,
+        destination: Destination::Warehouse,
+        products: kinds
+            .iter()
+            .enumerate()
+            .map(|(q, k)| KitProduct {
+                kind: *k,
+                quadrant: q as u8 + 1,
+                range: R,
+            })
+            .collect(),
     }
 }
 
@@ -381,20 +386,7 @@ pub fn soak(seed: u64) -> Trial {
                 let kinds: Vec<PartKind> = (0..n).map(|_| any_kind(&mut rng)).collect();
                 needed.extend(&kinds);
                 let tray = t.trays[rng.usize(..t.trays.len())].tray_id;
-                Task::Kitting {
-                    agv,
-                    tray_id: tray,
-                    destination: Destination::Warehouse,
-                    products: kinds
-                        .iter()
-                        .enumerate()
-                        .map(|(q, k)| KitProduct {
-                            kind: *k,
-                            quadrant: q as u8 + 1,
-                            range: R,
-                        })
-                        .collect(),
-                }
+                kitting(agv, tray, &kinds)
             }
             OrderType::Assembly if !assembly_agvs_used => {
                 let Some(station) = stations.pop() else {

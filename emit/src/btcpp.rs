@@ -197,7 +197,7 @@ fn control_tag(c: ControlKind) -> &'static str {
     }
 }
 
-fn decorator_tag(d: DecoratorKind) -> &'static str {
+fn decorator_tag(d: &DecoratorKind) -> &'static str {
     match d {
         DecoratorKind::Retry { .. } => "RetryUntilSuccessful",
         DecoratorKind::Repeat { .. } => "Repeat",
@@ -241,7 +241,7 @@ fn node(x: &mut Xml, n: &Node, ir: &TreeIr) {
             name,
             child,
         } => {
-            let tag = decorator_tag(*decorator);
+            let tag = decorator_tag(decorator);
             x.open(tag).name(name);
             match decorator {
                 DecoratorKind::Retry { times } => number(x, "num_attempts", times),

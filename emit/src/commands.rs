@@ -41,8 +41,9 @@ fn walk(n: &Node, step: Option<usize>, ir: &TreeIr, out: &mut Vec<Value>) {
         Node::Decorator {
             decorator, child, ..
         } => {
+            // A count left as a port (a call btc could not inline) runs once.
             let times = match decorator {
-                DecoratorKind::Repeat { times } => *times,
+                DecoratorKind::Repeat { times } => times.fixed().unwrap_or(1),
                 _ => 1,
             };
             for _ in 0..times {

@@ -17,7 +17,7 @@ fn control_label(c: ControlKind) -> String {
     }
 }
 
-fn decorator_label(d: DecoratorKind) -> String {
+fn decorator_label(d: &DecoratorKind) -> String {
     match d {
         DecoratorKind::Retry { times } => format!("retry {times}"),
         DecoratorKind::Repeat { times } => format!("repeat {times}"),
@@ -75,7 +75,7 @@ fn flatten(root: &Node, ir: &TreeIr) -> Flat {
             Node::Decorator {
                 decorator, name, ..
             } => {
-                let l = decorator_label(*decorator);
+                let l = decorator_label(decorator);
                 (
                     name.as_ref().map_or(l.clone(), |nm| format!("{l} {nm}")),
                     Shape::Decorator,

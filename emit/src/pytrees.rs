@@ -15,7 +15,7 @@
 //! text. The output is ASCII and deterministic.
 
 use btc_ir::{format_float, LeafKind, Node, NodeModel, Port, PortValue, StepInfo, TreeIr};
-use btc_ir::{ControlKind, DecoratorKind};
+use btc_ir::{ControlKind, Count, DecoratorKind};
 use btc_pddl::logic::{InitFact, Term, TypeText};
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write;
@@ -565,29 +565,42 @@ impl Emitter<'_> {
                 name,
                 child,
             } => {
-                let label = py_str(&name.clone().unwrap_or_else(|| decorator_name(*decorator)));
+                let label = py_str(&name.clone().unwrap_or_else(|| decorator_name(decorator)));
                 // BT.CPP ticks nothing under retry(0) / repeat(0).
-                match *decorator {
-                    DecoratorKind::Retry { times: 0 } => {
-                        return self.constant("Failure", &label, "retry(0) never ticks its child")
-                    }
-                    DecoratorKind::Repeat { times: 0 } => {
+                match decorator {
+                    DecoratorKind::Retry {
+                        times: Count::Fixed(0),
+                    } => return self.constant("Failure", &label, "retry(0) never ticks its child"),
+                    DecoratorKind::Repeat {
+                        times: Count::Fixed(0),
+                    } => {
                         return self.constant("Success", &label, "repeat(0) never ticks its child")
+                    }
+                    // py_trees takes the number when the tree is built.
+                    _ if decorator.count().is_some_and(|c| c.fixed().is_none()) => {
+                        return self.constant(
+                            "Failure",
+                            &label,
+                            "a decorator count from a call btc could not inline",
+                        )
                     }
                     _ => {}
                 }
                 let c = self.node(child);
                 let v = self.var();
-                let expr = match *decorator {
+                let n = |c: &Count| c.fixed().unwrap_or_default();
+                let expr = match decorator {
                     DecoratorKind::Retry { times } => format!(
-                        "py_trees.decorators.Retry(name={label}, child={c}, num_failures={times})"
+                        "py_trees.decorators.Retry(name={label}, child={c}, num_failures={})",
+                        n(times)
                     ),
                     DecoratorKind::Repeat { times } => format!(
-                        "py_trees.decorators.Repeat(name={label}, child={c}, num_success={times})"
+                        "py_trees.decorators.Repeat(name={label}, child={c}, num_success={})",
+                        n(times)
                     ),
                     DecoratorKind::Timeout { ms } => format!(
                         "py_trees.decorators.Timeout(name={label}, child={c}, duration={})",
-                        format_float(ms as f64 / 1000.0)
+                        format_float(n(ms) as f64 / 1000.0)
                     ),
                     DecoratorKind::Inverter => {
                         format!("py_trees.decorators.Inverter(name={label}, child={c})")
@@ -709,7 +722,7 @@ fn control_name(c: ControlKind) -> &'static str {
     }
 }
 
-fn decorator_name(d: DecoratorKind) -> String {
+fn decorator_name(d: &DecoratorKind) -> String {
     match d {
         DecoratorKind::Retry { times } => format!("Retry({times})"),
         DecoratorKind::Repeat { times } => format!("Repeat({times})"),

@@ -15,7 +15,7 @@ use serde::{Deserialize, Serialize};
 
 pub mod json;
 mod nodes;
-pub use nodes::{ControlKind, DecoratorKind};
+pub use nodes::{ControlKind, Count, DecoratorKind};
 
 /// The version of the IR's JSON encoding (`"ir_version"`). Version 1 (PDDL
 /// as strings, no world) is still read: [`json::decode`].
@@ -254,7 +254,13 @@ impl TreeIr {
                 name,
                 child,
             } => Node::Decorator {
-                decorator: *decorator,
+                decorator: match decorator.count() {
+                    Some(Count::Param { param }) => match count_of(param, args) {
+                        Some(c) => decorator.with_count(c),
+                        None => decorator.clone(),
+                    },
+                    _ => decorator.clone(),
+                },
                 name: name.as_ref().map(|s| interpolate(s, args)),
                 child: Box::new(self.inline_node(child, args, depth)),
             },
@@ -293,6 +299,17 @@ fn substitute(v: &PortValue, args: &[Port]) -> PortValue {
             .find(|a| a.name == *p)
             .map_or_else(|| v.clone(), |a| a.value.clone()),
         other => other.clone(),
+    }
+}
+
+/// What a call passes for a decorator's count parameter: a number, or a
+/// port of the calling tree (`None` when it passes no whole number).
+fn count_of(param: &str, args: &[Port]) -> Option<Count> {
+    match &args.iter().find(|a| a.name == param)?.value {
+        PortValue::Int(n) => u64::try_from(*n).ok().map(Count::Fixed),
+        PortValue::Text(t) => t.parse().ok().map(Count::Fixed),
+        PortValue::Param(p) => Some(Count::Param { param: p.clone() }),
+        _ => None,
     }
 }
 

@@ -24,19 +24,50 @@ impl ControlKind {
     }
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "kebab-case")]
 pub enum DecoratorKind {
-    Retry { times: u32 },
-    Repeat { times: u32 },
-    Timeout { ms: u64 },
+    Retry { times: Count },
+    Repeat { times: Count },
+    Timeout { ms: Count },
     Inverter,
     ForceSuccess,
     ForceFailure,
 }
 
+/// A decorator's count or duration: a number, or (in a rule's tree, when
+/// the number depends on the plan step) a port of the enclosing tree,
+/// which each call fills in (`{name}` in BT.CPP). In JSON a number is a
+/// number and a port is `{"param": "name"}`.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Count {
+    Fixed(u64),
+    Param { param: String },
+}
+
+impl Count {
+    /// The number, when it is one.
+    pub fn fixed(&self) -> Option<u64> {
+        match self {
+            Count::Fixed(n) => Some(*n),
+            Count::Param { .. } => None,
+        }
+    }
+}
+
+impl std::fmt::Display for Count {
+    /// `3`, or `{name}` as BT.CPP writes a port.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Count::Fixed(n) => write!(f, "{n}"),
+            Count::Param { param } => write!(f, "{{{param}}}"),
+        }
+    }
+}
+
 impl DecoratorKind {
-    pub fn keyword(self) -> &'static str {
+    pub fn keyword(&self) -> &'static str {
         match self {
             DecoratorKind::Retry { .. } => "retry",
             DecoratorKind::Repeat { .. } => "repeat",
@@ -44,6 +75,25 @@ impl DecoratorKind {
             DecoratorKind::Inverter => "inverter",
             DecoratorKind::ForceSuccess => "force_success",
             DecoratorKind::ForceFailure => "force_failure",
+        }
+    }
+
+    /// The count or duration, for the decorators that have one.
+    pub fn count(&self) -> Option<&Count> {
+        match self {
+            DecoratorKind::Retry { times } | DecoratorKind::Repeat { times } => Some(times),
+            DecoratorKind::Timeout { ms } => Some(ms),
+            _ => None,
+        }
+    }
+
+    /// The same decorator with its count replaced.
+    pub fn with_count(&self, count: Count) -> DecoratorKind {
+        match self {
+            DecoratorKind::Retry { .. } => DecoratorKind::Retry { times: count },
+            DecoratorKind::Repeat { .. } => DecoratorKind::Repeat { times: count },
+            DecoratorKind::Timeout { .. } => DecoratorKind::Timeout { ms: count },
+            other => other.clone(),
         }
     }
 }

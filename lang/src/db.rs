@@ -5,7 +5,9 @@
 
 use crate::path::{AsFilePath, FilePath};
 use crate::project::ReadFailure;
-use crate::rules::check::{check_file, check_item, Decls, DomainCtx};
+use crate::rules::actions::ActionIndex;
+use crate::rules::check::{check_item, Decls, DomainCtx};
+use crate::rules::file_checks::{self, Finding, ItemHead, ItemUses, RuleFacts};
 use crate::rules::parse::{parse_item_text, parse_rules_with, shift};
 use crate::rules::{ImportTarget, Item, ItemNode, ParsedRules};
 use btc_pddl::diagnostic::{codes, Diagnostic};
@@ -266,11 +268,7 @@ fn item_key(item: &Item) -> String {
                 .iter()
                 .map(|p| p.var.text.clone())
                 .collect();
-            format!(
-                "rule {} {}",
-                r.pattern.name_text().to_lowercase(),
-                params.join(" ")
-            )
+            format!("rule {} {}", r.pattern.name_key(), params.join(" "))
         }
         Item::Plan { .. } => "plan".into(),
         Item::Error { .. } => "error".into(),
@@ -430,6 +428,30 @@ pub fn declarations(db: &dyn Db, file: SourceFile) -> Decls {
     decls
 }
 
+/// The domain's action names indexed for matching patterns.
+#[salsa::tracked(returns(ref))]
+pub fn action_index(db: &dyn Db, domain: SourceFile) -> ActionIndex {
+    match &checked_domain(db, domain).domain {
+        Some(d) => ActionIndex::new(d),
+        None => ActionIndex::default(),
+    }
+}
+
+/// The PDDL side a rules file's items are checked against: its domain
+/// (when it can be read) and problem.
+pub fn domain_ctx(db: &dyn Db, file: SourceFile) -> Option<DomainCtx<'_>> {
+    let domain = domain_file(db, file)?;
+    let cd = checked_domain(db, domain);
+    let problem =
+        problem_file(db, file).map(|p| checked_problem(db, ProblemOf::new(db, p, domain)));
+    Some(DomainCtx {
+        domain: cd.domain.as_ref()?,
+        index: &cd.index,
+        problem: problem.map(|p| &p.index),
+        actions: action_index(db, domain),
+    })
+}
+
 /// Diagnostics of one item, relative to its start. Reads only the item's
 /// tree, the declarations and the PDDL files, so edits elsewhere in the file
 /// leave it alone.
@@ -437,21 +459,77 @@ pub fn declarations(db: &dyn Db, file: SourceFile) -> Decls {
 pub fn item_diagnostics<'db>(db: &'db dyn Db, item: RulesItem<'db>) -> Vec<Diagnostic> {
     let file = item.file(db);
     let decls = declarations(db, file);
-    let domain = domain_file(db, file);
-    let problem = problem_file(db, file);
-    let cd = domain.map(|d| checked_domain(db, d));
-    let cp = match (problem, domain) {
-        (Some(p), Some(d)) => Some(checked_problem(db, ProblemOf::new(db, p, d))),
-        _ => None,
+    check_item(
+        item.item(db),
+        decls,
+        domain_ctx(db, file),
+        file_id(db, file),
+    )
+}
+
+/// What the file-level checks need of an item's head (nothing of a body).
+#[salsa::tracked(returns(ref))]
+pub fn item_head<'db>(db: &'db dyn Db, item: RulesItem<'db>) -> ItemHead {
+    file_checks::head(item.item(db))
+}
+
+/// The names an item uses, for R014.
+#[salsa::tracked(returns(ref))]
+pub fn item_uses<'db>(db: &'db dyn Db, item: RulesItem<'db>) -> ItemUses {
+    file_checks::uses(item.item(db))
+}
+
+/// The actions a rule can match, for R012 and R013 (`None` for items that
+/// are no rules, or without a domain).
+#[salsa::tracked(returns(ref))]
+pub fn rule_facts<'db>(db: &'db dyn Db, item: RulesItem<'db>) -> Option<RuleFacts> {
+    let Item::Rule(r) = item.item(db) else {
+        return None;
     };
-    let ctx = cd.and_then(|c| {
-        c.domain.as_ref().map(|domain| DomainCtx {
-            domain,
-            index: &c.index,
-            problem: cp.map(|p| &p.index),
-        })
-    });
-    check_item(item.item(db), decls, ctx, file_id(db, file))
+    let file = item.file(db);
+    let ctx = domain_ctx(db, file)?;
+    Some(file_checks::rule_facts(r, declarations(db, file), ctx))
+}
+
+/// The heads of a file's items, in order.
+#[salsa::tracked(returns(ref))]
+pub fn item_heads(db: &dyn Db, file: SourceFile) -> Vec<ItemHead> {
+    rules_items(db, file)
+        .iter()
+        .map(|i| item_head(db, *i).clone())
+        .collect()
+}
+
+/// One `domain`, one `plan`, names declared once.
+#[salsa::tracked(returns(ref))]
+pub fn file_structure(db: &dyn Db, file: SourceFile) -> Vec<Finding> {
+    file_checks::structure(item_heads(db, file))
+}
+
+/// R012 and R013 over the file's rules.
+#[salsa::tracked(returns(ref))]
+pub fn file_coverage(db: &dyn Db, file: SourceFile) -> Vec<Finding> {
+    let Some(domain) = domain_file(db, file) else {
+        return Vec::new();
+    };
+    let Some(d) = &checked_domain(db, domain).domain else {
+        return Vec::new();
+    };
+    let items = rules_items(db, file);
+    let facts: Vec<(usize, &RuleFacts)> = items
+        .iter()
+        .enumerate()
+        .filter_map(|(k, i)| rule_facts(db, *i).as_ref().map(|f| (k, f)))
+        .collect();
+    file_checks::coverage(&facts, d.actions.len())
+}
+
+/// R014 over the file's declarations.
+#[salsa::tracked(returns(ref))]
+pub fn file_unused(db: &dyn Db, file: SourceFile) -> Vec<Finding> {
+    let items = rules_items(db, file);
+    let uses: Vec<&ItemUses> = items.iter().map(|i| item_uses(db, *i)).collect();
+    file_checks::unused(item_heads(db, file), &uses)
 }
 
 /// Every diagnostic of a rules file itself (not of its PDDL files), with
@@ -512,15 +590,16 @@ pub fn rules_diagnostics(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
             ));
         }
     }
-    let cd = domain.map(|d| checked_domain(db, d));
-    let ctx = cd.and_then(|c| {
-        c.domain.as_ref().map(|domain| DomainCtx {
-            domain,
-            index: &c.index,
-            problem: None,
-        })
-    });
-    out.extend(check_file(&parsed.items, declarations(db, file), ctx, id));
+    let heads = item_heads(db, file);
+    let offsets: Vec<u32> = rules_items(db, file).iter().map(|i| i.offset(db)).collect();
+    let d = domain.and_then(|d| checked_domain(db, d).domain.as_ref());
+    for f in file_structure(db, file)
+        .iter()
+        .chain(file_coverage(db, file))
+        .chain(file_unused(db, file))
+    {
+        out.extend(file_checks::render(f, heads, &offsets, d, id));
+    }
     out.sort_by_key(|d| (d.span.file != id, d.span.start));
     out
 }
@@ -622,11 +701,47 @@ mod tests {
             reparsed, 1,
             "only the edited item is parsed again: {log:#?}"
         );
+        // The file-level checks read summaries the edit left equal: they
+        // do not run again over every rule.
+        for query in [
+            "file_coverage",
+            "file_unused",
+            "file_structure",
+            "item_heads",
+        ] {
+            assert!(
+                !log.iter().any(|l| l.starts_with(query)),
+                "{query} ran again: {log:#?}"
+            );
+        }
+        let summarized = log.iter().filter(|l| l.starts_with("rule_facts")).count();
+        assert_eq!(summarized, 1, "{log:#?}");
         assert_eq!(after.len(), 1, "{after:?}");
         assert!(
             after[0].ends_with(":27:45: error[R006]: `?destination` is not bound here"),
             "{after:?}"
         );
+    }
+
+    #[test]
+    fn a_new_rule_reruns_coverage_once() {
+        let mut db = Database::new();
+        load(&mut db, "examples/ariac/domain.pddl");
+        let f = load(&mut db, "lang/tests/fixtures/large.btrules");
+        let before = errors(&db, f).len();
+        db.start_logging();
+        let text = format!(
+            "{}\nrule (flip ?robot ?p ?c) {{ Flip(robot: ?robot, part: ?p, container: ?c) }}\n",
+            f.text(&db)
+        );
+        db.set_file(f.path(&db).clone().as_str(), text);
+        let after = errors(&db, f);
+        let log = db.take_log();
+        let count = |q: &str| log.iter().filter(|l| l.starts_with(q)).count();
+        assert_eq!(count("file_coverage"), 1, "{log:#?}");
+        assert_eq!(count("rule_facts"), 1, "only the new rule: {log:#?}");
+        assert_eq!(after.len(), before + 1, "{after:?}");
+        assert!(after.iter().any(|e| e.contains("R013")));
     }
 
     #[test]

@@ -7,6 +7,7 @@
 use crate::rules::ast::*;
 use crate::rules::check::Decls;
 use crate::rules::matching::{match_args, match_name, Bindings, Captures, ObjectTypes};
+use crate::rules::name::{capture_value, Key};
 use btc_ir::format_float;
 use btc_ir::*;
 use btc_pddl::ast::{Domain, Problem};
@@ -20,7 +21,7 @@ use std::collections::{BTreeMap, BTreeSet};
 mod action;
 mod arrange;
 
-use action::ActionLogic;
+use action::{ActionLogic, RuleEffect};
 use arrange::kb_holds;
 
 pub struct LowerInput<'a> {
@@ -59,6 +60,8 @@ struct RuleTree {
     params: Vec<(String, Value)>,
     root: Node,
     typed: Vec<TypedPort>,
+    /// Parameters that are decorator counts, with their ranges.
+    counts: Vec<(String, DecoratorName, DecoratorParam)>,
 }
 
 /// Instantiates templates, either with a step's bindings (values filled in)
@@ -75,6 +78,8 @@ struct Inst<'a> {
     used_trees: BTreeSet<String>,
     /// Nesting of tree expansions (a tree may call trees).
     depth: usize,
+    /// Parameters that are decorator counts, checked at each call.
+    counts: Vec<(String, DecoratorName, DecoratorParam)>,
 }
 
 /// A tree declaration's body with the call's argument expressions put in
@@ -82,7 +87,7 @@ struct Inst<'a> {
 fn expand_tree(decl: &TreeDecl, args: &[Arg]) -> Vec<Template> {
     let arg = |port: &str| -> Option<&Value> {
         args.iter()
-            .find(|a| a.port.text.to_lowercase() == port)
+            .find(|a| a.port.key.as_str() == port)
             .map(|a| &a.value)
     };
     fn value<'a>(v: &Value, arg: &dyn Fn(&str) -> Option<&'a Value>) -> Value {
@@ -143,11 +148,20 @@ fn expand_tree(decl: &TreeDecl, args: &[Arg]) -> Vec<Template> {
             },
             Template::Decorator {
                 decorator,
+                args,
                 name,
                 child,
                 span,
             } => Template::Decorator {
                 decorator: *decorator,
+                args: args
+                    .iter()
+                    .map(|a| DecoratorArg {
+                        param: a.param.clone(),
+                        value: value(&a.value, arg),
+                        span: a.span,
+                    })
+                    .collect(),
                 name: name.as_ref().map(|n| string(n, arg)),
                 child: Box::new(template(child, arg)),
                 span: *span,
@@ -231,11 +245,9 @@ impl Inst<'_> {
                 }
                 PortValue::Text(self.lookup_var(&name.text).unwrap_or_default().to_owned())
             }
-            Value::Name { name } => PortValue::Text(
-                self.lookup_capture(&name.text)
-                    .unwrap_or(&name.text)
-                    .to_uppercase(),
-            ),
+            Value::Name { name } => PortValue::Text(capture_value(
+                self.lookup_capture(&name.text).unwrap_or(&name.text),
+            )),
             Value::Str { value } => PortValue::Text(self.string(value)),
             Value::Int { value, .. } => PortValue::Int(*value),
             Value::Float { value, .. } => PortValue::Float(*value),
@@ -245,11 +257,11 @@ impl Inst<'_> {
                     PortValue::Text(t) => t,
                     other => other.to_text(),
                 };
-                let entry = self.decls.tables.get(&table.text).and_then(|t| {
-                    t.entries
-                        .iter()
-                        .find(|e| e.key.text.eq_ignore_ascii_case(&key))
-                });
+                let entry = self
+                    .decls
+                    .tables
+                    .get(&table.text)
+                    .and_then(|t| t.entries.iter().find(|e| e.key.key == Key::new(&key)));
                 match entry.map(|e| &e.value) {
                     Some(Literal::Int { value, .. }) => PortValue::Int(*value),
                     Some(Literal::Float { value, .. }) => PortValue::Float(*value),
@@ -278,7 +290,7 @@ impl Inst<'_> {
                     }
                 },
                 StrPart::Capture { name } => match self.lookup_capture(&name.text) {
-                    Some(c) if self.params.is_none() => out.push_str(&c.to_uppercase()),
+                    Some(c) if self.params.is_none() => out.push_str(&capture_value(c)),
                     _ => {
                         out.push('{');
                         out.push_str(&name.text);
@@ -310,6 +322,50 @@ impl Inst<'_> {
         Some(self.string(s))
     }
 
+    /// A decorator of the IR: its argument evaluated, or (in a rule's
+    /// parametric tree, when it depends on the step) a parameter of the
+    /// tree that each step's call fills in. The checker has made sure the
+    /// argument is a whole number in range (R004, R023).
+    fn decorator(&mut self, d: DecoratorName, args: &[DecoratorArg]) -> DecoratorKind {
+        let count = |this: &mut Self, param: &str| -> Count {
+            let (Some(a), Some(range)) = (args.first(), d.param()) else {
+                return Count::Fixed(0);
+            };
+            let v = this.value(&a.value, param);
+            if let Some(n) = count_in_range(&v, range) {
+                return Count::Fixed(n);
+            }
+            // A parameter, or (in a rule's tree) a value the checker could
+            // not see; each call's value is checked where the step is.
+            let p = match v {
+                PortValue::Param(p) => p,
+                _ if this.params.is_some() => match this.param_for(&a.value, param) {
+                    PortValue::Param(p) => p,
+                    _ => unreachable!("param_for gives a parameter"),
+                },
+                _ => return Count::Fixed(0),
+            };
+            if this.params.is_some() && this.tree_ports.is_empty() {
+                this.counts.push((p.clone(), d, range));
+            }
+            Count::Param { param: p }
+        };
+        match d {
+            DecoratorName::Retry => DecoratorKind::Retry {
+                times: count(self, "times"),
+            },
+            DecoratorName::Repeat => DecoratorKind::Repeat {
+                times: count(self, "times"),
+            },
+            DecoratorName::Timeout => DecoratorKind::Timeout {
+                ms: count(self, "msec"),
+            },
+            DecoratorName::Inverter => DecoratorKind::Inverter,
+            DecoratorName::ForceSuccess => DecoratorKind::ForceSuccess,
+            DecoratorName::ForceFailure => DecoratorKind::ForceFailure,
+        }
+    }
+
     fn templates(&mut self, ts: &[Template], steps: &dyn Fn(StepsMode) -> Vec<Node>) -> Vec<Node> {
         ts.iter().flat_map(|t| self.template(t, steps)).collect()
     }
@@ -331,11 +387,13 @@ impl Inst<'_> {
             }
             Template::Decorator {
                 decorator,
+                args,
                 name,
                 child,
                 ..
             } => {
                 let name = self.name(name);
+                let kind = self.decorator(*decorator, args);
                 let mut kids = self.template(child, steps);
                 let child = if kids.len() == 1 {
                     kids.remove(0)
@@ -343,7 +401,7 @@ impl Inst<'_> {
                     Node::sequence(kids)
                 };
                 vec![Node::Decorator {
-                    decorator: *decorator,
+                    decorator: kind,
                     name,
                     child: Box::new(child),
                 }]
@@ -386,6 +444,19 @@ impl Inst<'_> {
             Template::Error { .. } => Vec::new(),
         }
     }
+}
+
+/// A value as a decorator's count, when it is a whole number in range.
+fn count_in_range(v: &PortValue, range: DecoratorParam) -> Option<u64> {
+    let n = match v {
+        PortValue::Int(n) => *n,
+        PortValue::Text(t) => t.parse().ok()?,
+        _ => return None,
+    };
+    (range.min..=range.max)
+        .contains(&n)
+        .then(|| u64::try_from(n).ok())
+        .flatten()
 }
 
 /// A value's identity without its spans: two uses of `?robot` are one
@@ -446,6 +517,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
     };
     let tables = |name: &str| input.decls.tables.get(name).cloned();
     let mut actions: BTreeMap<usize, ActionLogic> = BTreeMap::new();
+    let mut rule_effects: BTreeMap<usize, RuleEffect> = BTreeMap::new();
     let mut rule_trees: Vec<(usize, RuleTree)> = Vec::new(); // by rule index
     let mut taken = BTreeSet::new();
     let mut used_nodes = BTreeSet::new();
@@ -534,12 +606,38 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
             step_nodes.push(None);
             continue;
         };
-        let RuleBody::Template { body, .. } = &rule.body else {
+        let RuleBody::Template { body, effect } = &rule.body else {
             info.skipped = true;
             infos.push(info);
             step_nodes.push(None);
             continue;
         };
+        // A rule's `effect` is the step's effect, in every target: it takes
+        // the place of the PDDL action's (at start and at end), applied
+        // when the step succeeds.
+        if let Some(e) = effect {
+            let lifted = rule_effects.entry(ri).or_insert_with(|| RuleEffect::new(e));
+            match lifted.ground(&bindings) {
+                Ok(e) => {
+                    info.eff_start = None;
+                    info.eff_end = e;
+                }
+                Err(var) => {
+                    diags.push(
+                        Diagnostic::error(
+                            codes::R_EFFECT_UNBOUND,
+                            step.span,
+                            format!(
+                                "step {} `{}`: its rule's effect reads `?{var}`, which this step leaves out",
+                                k + 1,
+                                info.display()
+                            ),
+                        )
+                        .with_hint("an optional parameter the step does not give cannot stand in the rule's `effect`; write a rule for the shorter form"),
+                    );
+                }
+            }
+        }
         let pos = match rule_trees.iter().position(|(i, _)| *i == ri) {
             Some(p) => p,
             None => {
@@ -554,6 +652,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
                     used_nodes: BTreeSet::new(),
                     used_trees: BTreeSet::new(),
                     depth: 0,
+                    counts: Vec::new(),
                 };
                 let mut nodes = inst.templates(body, &|_| Vec::new());
                 let root = if nodes.len() == 1 {
@@ -569,6 +668,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
                         id,
                         params: inst.params.unwrap_or_default(),
                         typed: typed_ports(&root, input),
+                        counts: inst.counts,
                         root,
                     },
                 ));
@@ -585,6 +685,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
             used_nodes: BTreeSet::new(),
             used_trees: BTreeSet::new(),
             depth: 0,
+            counts: Vec::new(),
         };
         let ports: Vec<Port> = rt
             .params
@@ -594,6 +695,35 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
                 value: call_inst.eval(expr),
             })
             .collect();
+        // A decorator count that depends on the step must be a number in
+        // its range (a table may lack the key of this step's object).
+        for (param, d, range) in &rt.counts {
+            let Some(v) = ports.iter().find(|p| p.name == *param).map(|p| &p.value) else {
+                continue;
+            };
+            if count_in_range(v, *range).is_none() {
+                diags.push(
+                    Diagnostic::error(
+                        codes::R_BAD_ARGUMENT,
+                        step.span,
+                        format!(
+                            "step {} `{}`: `{}` gets {}, which is not a number of {} from {} to {}",
+                            k + 1,
+                            info.display(),
+                            d.keyword(),
+                            match v {
+                                PortValue::Text(t) if t.is_empty() => "no value".to_owned(),
+                                other => format!("`{}`", other.to_text()),
+                            },
+                            range.what,
+                            range.min,
+                            range.max
+                        ),
+                    )
+                    .with_hint("a table lookup gives no value for a key the table does not have; add the key"),
+                );
+            }
+        }
         // Objects bound to PDDL-typed ports must fit the port's type.
         check_port_types(
             &rt.typed,
@@ -667,6 +797,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
                 used_nodes: BTreeSet::new(),
                 used_trees: BTreeSet::new(),
                 depth: 0,
+                counts: Vec::new(),
             };
             let mut nodes = inst.templates(t, &arranged);
             used_nodes.extend(inst.used_nodes);
@@ -746,7 +877,7 @@ fn typed_ports(root: &Node, input: &LowerInput) -> Vec<TypedPort> {
             let Some(pd) = decl.ports.iter().find(|d| d.name.text == p.name) else {
                 continue;
             };
-            let ty = pd.ty.text.to_lowercase();
+            let ty = pd.ty.key.clone().into_string();
             if crate::rules::check::BASIC_TYPES.contains(&ty.as_str())
                 || input.dix.types.id(&ty).is_none()
             {

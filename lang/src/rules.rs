@@ -1,11 +1,16 @@
 //! The `.btrules` language: lexer, syntax tree, parser, formatter.
 
+pub mod actions;
 pub mod ast;
 pub mod check;
+pub mod file_checks;
 pub mod fmt;
 pub mod lexer;
 pub mod matching;
+pub mod name;
 pub mod parse;
+pub mod reach;
+pub mod skip;
 
 pub use ast::*;
 pub use parse::{parse_rules, ParsedRules};

@@ -425,7 +425,9 @@ fn hostile_ir() -> TreeIr {
     children.push(Node::Step {
         step: 1,
         child: Box::new(Node::Decorator {
-            decorator: DecoratorKind::Retry { times: 2 },
+            decorator: DecoratorKind::Retry {
+                times: btc_ir::Count::Fixed(2),
+            },
             name: Some("retry \"'''\"".into()),
             child: Box::new(Node::Control {
                 control: ControlKind::Parallel {

@@ -5,7 +5,9 @@ use crate::convert::LineIndex;
 use crate::syntax::FileSyntax;
 use crate::syntax::Tokens;
 use crate::workspace::Workspace;
-use btc_lang::db::{checked_domain, declarations, import_closure, parsed_rules, SourceFile};
+use btc_lang::db::{
+    action_index, checked_domain, declarations, import_closure, parsed_rules, SourceFile,
+};
 use btc_lang::path::FilePath;
 use btc_lang::rules::ast::{Item, ItemNode, Rule};
 use btc_lang::rules::check::{matched_actions, Decls};
@@ -98,7 +100,7 @@ impl<'a> Analysis<'a> {
     /// The domain actions a rule's pattern matches.
     pub fn actions_of(&self, r: &Rule) -> Vec<&'a Action> {
         match self.domain {
-            Some((_, d, _)) => matched_actions(&r.pattern, d)
+            Some((f, d, _)) => matched_actions(&r.pattern, d, action_index(&self.ws.db, f))
                 .into_iter()
                 .map(|(a, _)| a)
                 .collect(),

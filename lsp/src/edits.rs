@@ -6,6 +6,7 @@ use crate::convert::LineIndex;
 use btc_lang::db::{import_closure, parsed_rules, rules_diagnostics};
 use btc_lang::rules::ast::Item;
 use btc_lang::rules::matching::match_name;
+use btc_lang::rules::name::camel_case;
 use btc_pddl::ast::{Action, TypeSpec};
 use btc_pddl::diagnostic::Diagnostic;
 use std::collections::HashMap;
@@ -82,23 +83,6 @@ pub fn code_actions(
     out
 }
 
-/// `pick-up` / `PICK_UP` -> `PickUp`.
-fn camel(name: &str) -> String {
-    name.split(['-', '_'])
-        .filter(|w| !w.is_empty())
-        .map(|w| {
-            let mut c = w.chars();
-            c.next()
-                .map(|f| {
-                    f.to_uppercase()
-                        .chain(c.flat_map(char::to_lowercase))
-                        .collect::<String>()
-                })
-                .unwrap_or_default()
-        })
-        .collect()
-}
-
 fn port_name(var: &str) -> String {
     var.replace('-', "_")
 }
@@ -140,7 +124,7 @@ pub fn rule_stubs(a: &Analysis) -> Option<String> {
         text.push('\n');
     }
     for act in uncovered {
-        let node = camel(&act.name.name);
+        let node = camel_case(&act.name.name);
         text.push('\n');
         if !a.decls.nodes.contains_key(&node) && !a.decls.trees.contains_key(&node) {
             let ports: Vec<String> = act

@@ -4,6 +4,7 @@ use crate::analysis::{shift, Analysis, Place};
 use crate::syntax::Symbol;
 use btc_lang::db::file_id;
 use btc_lang::rules::ast::{Item, NodeKind};
+use btc_lang::rules::name::Key;
 use btc_pddl::source::Span;
 use std::collections::HashMap;
 use tower_lsp::lsp_types::{
@@ -159,8 +160,9 @@ pub fn hover(a: &Analysis, offset: usize) -> Option<Hover> {
         }
         Symbol::Type { name } => {
             let (_, _, dix) = a.domain?;
-            let lower = name.to_lowercase();
-            match dix.types.id(&lower) {
+            let key = Key::new(name);
+            let lower = key.as_str();
+            match dix.types.id(lower) {
                 Some(id) => {
                     let parents: Vec<&str> = dix
                         .types
@@ -271,8 +273,8 @@ pub fn definition(a: &Analysis, offset: usize) -> Option<Place> {
         }
         Symbol::Type { name } => {
             let (dfile, d, _) = a.domain?;
-            let lower = name.to_lowercase();
-            let t = d.types.iter().find(|t| t.name.name == lower)?;
+            let key = Key::new(&name);
+            let t = d.types.iter().find(|t| t.name.name == key.as_str())?;
             Some(Place {
                 file: dfile,
                 span: t.name.span,
@@ -399,7 +401,7 @@ pub fn rename(a: &Analysis, offset: usize, new_name: &str) -> Result<WorkspaceEd
         return Err(RenameError(format!("`{new_name}` is not a valid name")));
     }
     let replacement = match sym {
-        Symbol::Var { .. } => format!("?{}", bare.to_lowercase()),
+        Symbol::Var { .. } => format!("?{}", Key::new(bare)),
         Symbol::Capture { .. } | Symbol::Node { .. } | Symbol::Table { .. } | Symbol::Port { .. } => {
             bare.to_owned()
         }

@@ -2,6 +2,7 @@
 
 use crate::analysis::{shift, Analysis, Place};
 use btc_lang::rules::ast::{ImportTarget, Item};
+use btc_lang::rules::name::contains_folded;
 use btc_pddl::source::Span;
 use tower_lsp::lsp_types::{DocumentSymbol, SymbolInformation, SymbolKind};
 
@@ -125,14 +126,13 @@ pub fn document_symbols(a: &Analysis) -> Vec<DocumentSymbol> {
 /// `query` (case-insensitively; all for an empty query).
 #[allow(deprecated)]
 pub fn workspace_symbols(ws: &crate::workspace::Workspace, query: &str) -> Vec<SymbolInformation> {
-    let q = query.to_lowercase();
     let mut out = Vec::new();
     for f in ws.all_rules() {
         let Some(a) = Analysis::new(ws, f.path(&ws.db)) else {
             continue;
         };
         for s in item_symbols(&a) {
-            if !s.name.to_lowercase().contains(&q) {
+            if !contains_folded(&s.name, query) {
                 continue;
             }
             let Some(location) = a.location(&Place {

@@ -6,6 +6,7 @@
 use btc_lang::rules::ast::{Item, ItemNode, NamePart};
 use btc_lang::rules::check::Decls;
 use btc_lang::rules::lexer::{lex, Comment, Tok};
+use btc_lang::rules::name::{find_folded, Key};
 use btc_pddl::source::Span;
 use btc_pddl::DomainIndex;
 
@@ -257,7 +258,7 @@ impl FileSyntax<'_> {
         match tok {
             Tok::Var(v) => Some(Symbol::Var {
                 item: item?,
-                name: v.to_lowercase(),
+                name: Key::new(v).into_string(),
             }),
             Tok::Str(s) => {
                 let it = &self.items[item?].item;
@@ -311,9 +312,10 @@ impl FileSyntax<'_> {
                 }
                 let in_pddl = self.tokens.in_pddl(i);
                 if in_pddl {
-                    if prev_punct(1) == Some("(") && self.is_predicate(&name.to_lowercase()) {
+                    let key = Key::new(name);
+                    if prev_punct(1) == Some("(") && self.is_predicate(key.as_str()) {
                         return Some(Symbol::Predicate {
-                            name: name.to_lowercase(),
+                            name: key.into_string(),
                         });
                     }
                     return None;
@@ -388,16 +390,13 @@ impl FileSyntax<'_> {
                 continue;
             }
             let raw = &self.text[s.start as usize..s.end as usize];
-            let lower = raw.to_ascii_lowercase();
-            let mut from = 0;
-            while let Some(k) = lower[from..].find(&needle.to_ascii_lowercase()) {
-                let at = s.start + (from + k) as u32 + 1;
+            for k in find_folded(raw, &needle) {
+                let at = s.start + k as u32 + 1;
                 out.push(Span {
                     start: at,
                     end: at + needle.len() as u32 - 2,
                     ..*s
                 });
-                from += k + needle.len();
             }
         }
         out

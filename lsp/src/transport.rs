@@ -144,7 +144,7 @@ impl<R: Read> Framer<R> {
             }
             let text = String::from_utf8_lossy(&line);
             match text.split_once(':') {
-                Some((name, value)) if name.trim().eq_ignore_ascii_case("content-length") => {
+                Some((name, value)) if is_content_length(name) => {
                     headers = true;
                     let value = value.trim();
                     length = Some(match value.parse::<u64>() {
@@ -196,6 +196,13 @@ impl<R: Read> Framer<R> {
         self.in_garbage = false;
         Next::Body(body)
     }
+}
+
+/// Header names in the base protocol are case-insensitive, as in HTTP; this
+/// is wire framing, not a name from a rules file, so it needs no `Key`.
+#[allow(clippy::disallowed_methods)]
+fn is_content_length(name: &str) -> bool {
+    name.trim().eq_ignore_ascii_case("content-length")
 }
 
 /// Where a `Content-Length:` header starts in `bytes`, if anywhere.

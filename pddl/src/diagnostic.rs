@@ -321,6 +321,13 @@ pub mod codes {
         R_UNKNOWN_TYPE = "R021", "a port type that is neither a PDDL type nor a basic type";
         R_PLAN_BLOCK = "R022", "a `plan` block that is missing, repeated or has no `steps`";
         R_BAD_ARGUMENT = "R023", "a control or decorator argument that makes no sense";
+        R_EFFECT_UNBOUND = "R033", "a rule effect that reads an optional parameter a step leaves out";
+        // .btrules: rules that no step can match, and skips that lose effects
+        R_CONTRADICTION = "R040", "a rule whose guards contradict each other, so no step matches it";
+        R_GUARD_TYPE = "R041", "a type guard that the variable's type can never fit";
+        R_DISJOINT = "R042", "a repeated variable (or `==` guard) whose parameters' types share no object";
+        R_GUARD_OBJECT = "R043", "a guard comparing a variable with an object that can never stand there";
+        R_SKIP_CHANGES = "R044", "a `=> skip` rule for steps whose effects change the world";
         R_TOO_DEEP = "R060", "a template nested deeper than btc supports";
         // Running trees (btc run)
         X_TREE_SYNTAX = "X001", "a behavior tree file that is not BT.CPP v4 XML or btc's JSON IR";

@@ -97,6 +97,7 @@ const ASTAR: Options = Options {
     algorithm: Algorithm::Astar,
     heuristic: Heuristic::Max,
     timeout: None,
+    improve: 0,
 };
 
 /// Problems where A* with h_max takes over a second; benchmarked with
@@ -128,6 +129,7 @@ fn table() {
                 algorithm: Algorithm::Astar,
                 heuristic,
                 timeout: Some(std::time::Duration::from_secs(60)),
+                ..Options::default()
             };
             stats_table(&format!("astar + {heuristic:?}"), &opts);
         }

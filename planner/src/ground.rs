@@ -5,6 +5,7 @@
 //! become auxiliary derived facts with one axiom per alternative.
 
 use crate::lifted::*;
+use crate::reach::{join_order, Part, Reach, Round, Step};
 use crate::task::{Axiom, GroundEffect, Lit, Operator, Task};
 use btc_pddl::ast::{Domain, Formula, NumOp};
 use btc_pddl::check::{DomainIndex, ProblemIndex};
@@ -148,9 +149,8 @@ struct Grounder<'a> {
     /// Predicates some effect changes; others are static.
     fluent: Vec<bool>,
     derived: Vec<bool>,
-    /// Reachable atoms (statics included), and per predicate.
-    reach: FxHashSet<Box<[u32]>>,
-    by_pred: Vec<Vec<Box<[u32]>>>,
+    /// Reachable atoms (statics included).
+    reach: Reach,
     facts: FxHashMap<Box<[u32]>, u32>,
     fact_keys: Vec<Box<[u32]>>,
     aux: FxHashMap<GF, u32>,
@@ -236,85 +236,6 @@ impl Grounder<'_> {
                 }
             }
             LE::Del { .. } | LE::Cost(..) => {}
-        }
-    }
-
-    fn add_reach(&mut self, k: Box<[u32]>) -> bool {
-        if self.reach.contains(&k) {
-            return false;
-        }
-        self.by_pred[k[0] as usize].push(k.clone());
-        self.reach.insert(k);
-        true
-    }
-
-    /// Bindings of a schema's parameters that satisfy its necessary atoms
-    /// in the reachable set; calls `leaf` for each complete one.
-    fn join(
-        &self,
-        atoms: &[(u32, Vec<LTerm>)],
-        params: &[std::rc::Rc<[u32]>],
-        allowed: &[Vec<bool>],
-        env: &mut [Option<u32>],
-        leaf: &mut dyn FnMut(&[u32]),
-    ) {
-        if self.expired() {
-            return;
-        }
-        if let Some(((pred, args), rest)) = atoms.split_first() {
-            let mut bound = [0usize; MAX_ARITY];
-            for t in &self.by_pred[*pred as usize] {
-                let mut nb = 0;
-                let mut ok = true;
-                for (i, a) in args.iter().enumerate() {
-                    let o = t[i + 1];
-                    match *a {
-                        LTerm::Obj(c) => ok = c == o,
-                        LTerm::Slot(s) => {
-                            let s = s as usize;
-                            match env[s] {
-                                Some(v) => ok = v == o,
-                                None => {
-                                    ok = allowed[s].get(o as usize).copied().unwrap_or(false);
-                                    if ok {
-                                        env[s] = Some(o);
-                                        bound[nb] = s;
-                                        nb += 1;
-                                    }
-                                }
-                            }
-                        }
-                    }
-                    if !ok {
-                        break;
-                    }
-                }
-                if ok {
-                    self.join(rest, params, allowed, env, leaf);
-                }
-                for &s in &bound[..nb] {
-                    env[s] = None;
-                }
-            }
-            return;
-        }
-        // Parameters no necessary atom binds range over their type.
-        match env.iter().position(Option::is_none) {
-            Some(s) if s < params.len() => {
-                for &o in params[s].iter() {
-                    env[s] = Some(o);
-                    self.join(atoms, params, allowed, env, leaf);
-                }
-                env[s] = None;
-            }
-            _ => {
-                let mut b = [0u32; MAX_PARAMS];
-                let n = params.len().min(MAX_PARAMS);
-                for (d, o) in b.iter_mut().zip(&env[..n]) {
-                    *d = o.unwrap_or(0);
-                }
-                leaf(&b[..n]);
-            }
         }
     }
 
@@ -479,35 +400,145 @@ impl Grounder<'_> {
     }
 }
 
-/// Orders a join: each next atom shares the most variables with those
-/// before it (so no cross products are built when a chain exists), with
-/// fewer new variables breaking ties.
-fn join_order(mut atoms: Vec<(u32, Vec<LTerm>)>, slots: usize) -> Vec<(u32, Vec<LTerm>)> {
-    let mut bound = vec![false; slots];
-    let mut out = Vec::with_capacity(atoms.len());
-    while !atoms.is_empty() {
-        let score = |(_, args): &(u32, Vec<LTerm>)| {
-            let known = args
-                .iter()
-                .filter(|a| match a {
-                    LTerm::Obj(_) => true,
-                    LTerm::Slot(s) => bound[*s as usize],
+/// How a schema takes part in the reachability fixpoint.
+struct Joins {
+    /// Semi-naive: one join per atom of the precondition, led by it, over
+    /// the atoms new in the round before. Naive: one join over all atoms,
+    /// run again every round, for schemas whose precondition is more than
+    /// a conjunction of atoms and (in)equalities or whose effects have
+    /// conditions (which may become reachable for an old binding).
+    steps: Vec<Vec<Step>>,
+    naive: bool,
+    conditional: bool,
+    allowed: Vec<Vec<bool>>,
+    /// What a binding the join finds must still satisfy: the whole
+    /// precondition when naive, only its non-atom literals otherwise.
+    check: LF,
+}
+
+impl Joins {
+    fn new(reach: &mut Reach, s: &Schema, nobj: usize, fixpoint: Fixpoint) -> Joins {
+        let mut atoms = Vec::new();
+        necessary_atoms(&s.pre_start, &mut atoms);
+        let all = atoms.len();
+        atoms.retain(|(_, args)| {
+            args.len() <= MAX_ARITY
+                && args.iter().all(|a| {
+                    matches!(a, LTerm::Obj(_))
+                        || matches!(a, LTerm::Slot(x) if (*x as usize) < s.params.len())
                 })
-                .count();
-            (known, usize::MAX - (args.len() - known))
+        });
+        let conditional = has_when(&s.eff_start) || has_when(&s.eff_end);
+        let naive = fixpoint == Fixpoint::Naive
+            || atoms.len() < all
+            || conditional
+            || !literal_conjunction(&s.pre_start);
+        let slots = s.slots.max(s.params.len());
+        let steps = if naive || atoms.is_empty() {
+            let order = join_order(&atoms, slots, None);
+            let ordered: Vec<_> = order.iter().map(|&i| atoms[i].clone()).collect();
+            vec![reach.plan(&ordered, &vec![Part::All; atoms.len()], slots)]
+        } else {
+            (0..atoms.len())
+                .map(|lead| {
+                    let order = join_order(&atoms, slots, Some(lead));
+                    let ordered: Vec<_> = order.iter().map(|&i| atoms[i].clone()).collect();
+                    let parts: Vec<Part> = order
+                        .iter()
+                        .map(|&i| match i.cmp(&lead) {
+                            std::cmp::Ordering::Less => Part::Old,
+                            std::cmp::Ordering::Equal => Part::New,
+                            std::cmp::Ordering::Greater => Part::All,
+                        })
+                        .collect();
+                    reach.plan(&ordered, &parts, slots)
+                })
+                .collect()
         };
-        let best = (0..atoms.len())
-            .max_by_key(|&i| (score(&atoms[i]), usize::MAX - i))
-            .unwrap_or(0);
-        let a = atoms.remove(best);
-        for t in &a.1 {
-            if let LTerm::Slot(s) = t {
-                bound[*s as usize] = true;
-            }
+        let allowed = s
+            .params
+            .iter()
+            .map(|objs| {
+                let mut v = vec![false; nobj];
+                for &o in objs.iter() {
+                    v[o as usize] = true;
+                }
+                v
+            })
+            .collect();
+        let check = if naive {
+            s.pre_start.clone()
+        } else {
+            let mut rest = Vec::new();
+            non_atoms(&s.pre_start, &mut rest);
+            LF::And(rest)
+        };
+        Joins {
+            steps,
+            naive,
+            conditional,
+            allowed,
+            check,
         }
-        out.push(a);
     }
-    out
+}
+
+/// Whether `f` is a conjunction of atoms, negated atoms and (in)equalities.
+fn literal_conjunction(f: &LF) -> bool {
+    match f {
+        LF::And(ps) => ps.iter().all(literal_conjunction),
+        LF::Atom { .. } | LF::Eq(..) => true,
+        LF::Not(g) => matches!(**g, LF::Atom { .. } | LF::Eq(..)),
+        _ => false,
+    }
+}
+
+/// The conjuncts of a literal conjunction other than positive atoms.
+fn non_atoms(f: &LF, out: &mut Vec<LF>) {
+    match f {
+        LF::And(ps) => ps.iter().for_each(|p| non_atoms(p, out)),
+        LF::Atom { .. } => {}
+        f => out.push(f.clone()),
+    }
+}
+
+fn has_when(e: &LE) -> bool {
+    match e {
+        LE::When(..) => true,
+        LE::And(ps) => ps.iter().any(has_when),
+        LE::Forall(_, b) => has_when(b),
+        _ => false,
+    }
+}
+
+/// Calls `leaf` for each completion of a join's bindings: parameters no
+/// atom bound range over their type.
+fn each_free(
+    params: &[std::rc::Rc<[u32]>],
+    env: &mut [Option<u32>],
+    stop: &dyn Fn() -> bool,
+    leaf: &mut dyn FnMut(&[u32]),
+) {
+    match env[..params.len()].iter().position(Option::is_none) {
+        Some(s) => {
+            for &o in params[s].iter() {
+                if stop() {
+                    break;
+                }
+                env[s] = Some(o);
+                each_free(params, env, stop, leaf);
+            }
+            env[s] = None;
+        }
+        None => {
+            let mut b = [0u32; MAX_PARAMS];
+            let n = params.len().min(MAX_PARAMS);
+            for (d, o) in b.iter_mut().zip(&env[..n]) {
+                *d = o.unwrap_or(0);
+            }
+            leaf(&b[..n]);
+        }
+    }
 }
 
 fn num_value(e: &LNum, env: &[u32], state: &State) -> Option<f64> {
@@ -549,6 +580,27 @@ pub fn ground(
     state: &State,
     goal: Option<&Formula>,
     deadline: Option<Instant>,
+) -> Result<Option<(Task, GroundStats)>, Vec<Diagnostic>> {
+    ground_with(domain, dix, pix, state, goal, deadline, Fixpoint::SemiNaive)
+}
+
+/// How the reachability fixpoint joins: semi-naive where that is exact
+/// (the default), or naive everywhere (what tests compare it with).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Fixpoint {
+    SemiNaive,
+    #[cfg_attr(not(test), allow(dead_code))]
+    Naive,
+}
+
+fn ground_with(
+    domain: &Domain,
+    dix: &DomainIndex,
+    pix: &ProblemIndex,
+    state: &State,
+    goal: Option<&Formula>,
+    deadline: Option<Instant>,
+    fixpoint: Fixpoint,
 ) -> Result<Option<(Task, GroundStats)>, Vec<Diagnostic>> {
     let mut c = Compiler::new(domain, dix, pix);
     let mut schemas: Vec<Schema> = (0..domain.actions.len()).map(|i| c.action(i)).collect();
@@ -614,8 +666,7 @@ pub fn ground(
     let mut g = Grounder {
         fluent,
         derived,
-        reach: FxHashSet::default(),
-        by_pred: vec![Vec::new(); npred],
+        reach: Reach::new(npred),
         facts: FxHashMap::default(),
         fact_keys: Vec::new(),
         aux: FxHashMap::default(),
@@ -630,72 +681,79 @@ pub fn ground(
     init.sort();
     for k in init {
         if (k[0] as usize) < npred && !g.derived[k[0] as usize] {
-            g.add_reach(k.clone());
+            g.reach.insert(k.clone());
         }
     }
 
     // Relaxed reachability fixpoint.
     let nobj = pix.object_names.len();
-    let prepared: Vec<_> = schemas
+    let joins: Vec<Joins> = schemas
         .iter()
-        .map(|s| {
-            let mut atoms = Vec::new();
-            necessary_atoms(&s.pre_start, &mut atoms);
-            atoms.retain(|(_, args)| {
-                args.len() <= MAX_ARITY
-                    && args.iter().all(|a| {
-                        matches!(a, LTerm::Obj(_))
-                            || matches!(a, LTerm::Slot(x) if (*x as usize) < s.params.len())
-                    })
-            });
-            let atoms = join_order(atoms, s.slots.max(s.params.len()));
-            let allowed: Vec<Vec<bool>> = s
-                .params
-                .iter()
-                .map(|objs| {
-                    let mut v = vec![false; nobj];
-                    for &o in objs.iter() {
-                        v[o as usize] = true;
-                    }
-                    v
-                })
-                .collect();
-            (atoms, allowed)
-        })
+        .map(|s| Joins::new(&mut g.reach, s, nobj, fixpoint))
         .collect();
     let mut seen: Vec<FxHashSet<Box<[u32]>>> = vec![FxHashSet::default(); schemas.len()];
     let mut order: Vec<Vec<Box<[u32]>>> = vec![Vec::new(); schemas.len()];
-    loop {
-        let mut changed = false;
+    let mut before = vec![0usize; npred];
+    for round in 0.. {
+        let now = g.reach.sizes();
+        let r = Round {
+            before: &before,
+            now: &now,
+        };
         for (i, s) in schemas.iter().enumerate() {
-            let (atoms, allowed) = &prepared[i];
+            let j = &joins[i];
+            if !j.naive && j.steps.len() == 1 && j.steps[0].is_empty() && round > 0 {
+                continue;
+            }
             let mut env = vec![None; s.slots.max(s.params.len())];
             let mut scratch = vec![0u32; s.slots.max(1)];
             let mut adds = Vec::new();
             let (seen, order) = (&mut seen[i], &mut order[i]);
-            g.join(atoms, &s.params, allowed, &mut env, &mut |b| {
-                if seen.contains(b) {
-                    return;
-                }
-                scratch[..b.len()].copy_from_slice(b);
-                if g.relaxed(&s.pre_start, &mut scratch, true) {
-                    seen.insert(b.into());
-                    g.relaxed_adds(&s.eff_start, &mut scratch, &mut adds);
-                    g.relaxed_adds(&s.eff_end, &mut scratch, &mut adds);
-                    order.push(b.into());
-                }
-            });
+            for steps in &j.steps {
+                g.reach.join(
+                    steps,
+                    &r,
+                    &j.allowed,
+                    &mut env,
+                    &|| g.expired(),
+                    &mut |env| {
+                        each_free(&s.params, env, &|| g.expired(), &mut |b| {
+                            scratch[..b.len()].copy_from_slice(b);
+                            if j.naive && seen.contains(b) {
+                                // Its precondition held before and still does;
+                                // a `when` may hold now that did not.
+                                if j.conditional {
+                                    g.relaxed_adds(&s.eff_start, &mut scratch, &mut adds);
+                                    g.relaxed_adds(&s.eff_end, &mut scratch, &mut adds);
+                                }
+                                return;
+                            }
+                            if g.relaxed(&j.check, &mut scratch, true) {
+                                if j.naive {
+                                    seen.insert(b.into());
+                                }
+                                g.relaxed_adds(&s.eff_start, &mut scratch, &mut adds);
+                                g.relaxed_adds(&s.eff_end, &mut scratch, &mut adds);
+                                order.push(b.into());
+                            }
+                        })
+                    },
+                );
+            }
             for k in adds {
-                changed |= g.add_reach(k);
+                g.reach.insert(k);
             }
         }
         if g.timed_out.get() {
             return Ok(None);
         }
-        if !changed {
+        if g.reach.sizes() == now {
             break;
         }
+        before = now;
     }
+    // A canonical operator order, whatever round found each binding.
+    order.iter_mut().for_each(|o| o.sort_unstable());
     let reachable_atoms = g.reach.len();
 
     // Facts: reachable atoms of fluent and derived predicates.
@@ -789,6 +847,7 @@ pub fn ground(
             }
         }
     }
+    let fact_preds = g.fact_keys.iter().map(|k| k[0]).collect();
     let fact_names = g
         .fact_keys
         .iter()
@@ -814,6 +873,7 @@ pub fn ground(
     };
     let mut task = Task {
         fact_names,
+        fact_preds,
         derived: is_derived,
         operators: ops,
         axioms,
@@ -831,6 +891,7 @@ pub fn ground(
             positive: true,
         }];
         task.fact_names.push("(false)".into());
+        task.fact_preds.push(u32::MAX);
         task.derived.push(true);
         task.goal[0].fact = (task.fact_names.len() - 1) as u32;
         task.words = task.fact_names.len().div_ceil(64);
@@ -974,14 +1035,74 @@ mod tests {
         assert_eq!(regress(lit(2, false), &value), GF::True);
     }
 
+    /// The semi-naive fixpoint finds what the naive one does: the same
+    /// atoms, operators and axioms, on every corpus problem.
     #[test]
-    fn joins_follow_shared_variables() {
-        // (at ?p ?a) (road ?x ?y) (link ?a ?x): the link comes second.
-        let at = (0, vec![LTerm::Slot(0), LTerm::Slot(1)]);
-        let road = (1, vec![LTerm::Slot(2), LTerm::Slot(3)]);
-        let link = (2, vec![LTerm::Slot(1), LTerm::Slot(2)]);
-        let order = join_order(vec![at, road, link], 4);
-        assert_eq!(order.iter().map(|a| a.0).collect::<Vec<_>>(), [0, 2, 1]);
+    fn semi_naive_grounding_agrees_with_naive_grounding() {
+        use btc_pddl::pipeline::{domain_unit_from, problem_unit_from};
+        use btc_pddl::state::World;
+        let Some(corpus) = btc_testkit::corpus() else {
+            return;
+        };
+        let mut compared = 0;
+        let mut dirs: Vec<_> = std::fs::read_dir(corpus)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .collect();
+        dirs.sort();
+        for dir in dirs {
+            for p in ["p01", "p02"] {
+                let own = dir.join(format!("{p}-domain.pddl"));
+                let d = if own.exists() {
+                    own
+                } else {
+                    dir.join("domain.pddl")
+                };
+                let read =
+                    |f: &std::path::Path| btc_pddl::source::decode(&std::fs::read(f).unwrap()).0;
+                let du = domain_unit_from(&read(&d), 0);
+                let dom = du.domain.as_ref().unwrap();
+                let pu = problem_unit_from(
+                    &read(&dir.join(format!("{p}.pddl"))),
+                    1,
+                    Some(dom),
+                    &du.index,
+                );
+                let prob = pu.problem.as_ref().unwrap();
+                let init = World::of_checked(dom, &du.index, prob, &pu.index)
+                    .expect("a world")
+                    .initial_state();
+                let run = |f| {
+                    ground_with(
+                        dom,
+                        &du.index,
+                        &pu.index,
+                        &init,
+                        prob.goal.as_ref(),
+                        None,
+                        f,
+                    )
+                    .unwrap()
+                    .unwrap()
+                };
+                let ((a, sa), (b, sb)) = (run(Fixpoint::SemiNaive), run(Fixpoint::Naive));
+                assert_eq!(sa, sb, "{}/{p}", dir.display());
+                assert_eq!(a.fact_names, b.fact_names, "{}/{p}", dir.display());
+                let ops = |t: &Task| {
+                    let mut v: Vec<_> = t
+                        .operators
+                        .iter()
+                        .map(|o| (o.action, o.args.clone(), o.pre.clone()))
+                        .collect();
+                    v.sort();
+                    v
+                };
+                assert_eq!(ops(&a), ops(&b), "{}/{p}", dir.display());
+                assert_eq!(a.axioms.len(), b.axioms.len());
+                compared += 1;
+            }
+        }
+        assert!(compared >= 40, "compared {compared}");
     }
 
     #[test]

@@ -39,14 +39,19 @@
 pub mod ground;
 pub mod heuristic;
 pub mod improve;
+pub mod lama;
+pub mod landmarks;
+pub mod lazy;
 pub mod lifted;
+pub mod lmcount;
 pub mod lmcut;
+mod reach;
 pub mod search;
 pub mod task;
 
 pub use ground::GroundStats;
 pub use heuristic::Heuristic;
-pub use search::{Algorithm, Options, SearchStats};
+pub use search::{Algorithm, Options, SearchStats, DEFAULT_IMPROVE};
 
 use btc_pddl::ast::{Domain, Formula, InitFact, Problem};
 use btc_pddl::check::{DomainIndex, ProblemIndex};

@@ -12,7 +12,12 @@ use std::time::{Duration, Instant};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Algorithm {
-    /// Greedy best-first search: fast, not necessarily optimal.
+    /// LAMA's search: lazy greedy search with h_FF, landmarks and preferred
+    /// operators, then restarts that improve the plan within
+    /// [`Options::improve`] ([`crate::lama`]). The heuristic option is not
+    /// used.
+    Lama,
+    /// Eager greedy best-first search: fast, not necessarily optimal.
     Gbfs,
     /// A*: optimal with an admissible heuristic.
     Astar,
@@ -22,16 +27,28 @@ pub enum Algorithm {
 pub struct Options {
     pub algorithm: Algorithm,
     pub heuristic: Heuristic,
-    /// Stop after this long.
+    /// Stop after this long (with `Lama`, the best plan found by then is
+    /// the answer).
     pub timeout: Option<Duration>,
+    /// `Lama`: the work the restarts may spend improving the first plan
+    /// ([`crate::lazy::Counts::work`]: about the facts, relaxed operators
+    /// and state words visited).
+    /// A measure of work rather than time keeps the plan the same on every
+    /// machine; 0 stops at the first plan.
+    pub improve: u64,
 }
+
+/// The default base budget of the restarts (plus four times the first
+/// search's work): a few tens of milliseconds, see docs/planner.md.
+pub const DEFAULT_IMPROVE: u64 = 2_000_000;
 
 impl Default for Options {
     fn default() -> Self {
         Options {
-            algorithm: Algorithm::Gbfs,
+            algorithm: Algorithm::Lama,
             heuristic: Heuristic::Ff,
             timeout: None,
+            improve: DEFAULT_IMPROVE,
         }
     }
 }
@@ -44,6 +61,13 @@ pub struct SearchStats {
     pub generated: usize,
     pub evaluated: usize,
     pub time: Duration,
+    /// `Lama`: searches run, the cost of the first plan, and whether a
+    /// search proved the last plan optimal.
+    pub iterations: usize,
+    pub first_cost: Option<u64>,
+    pub proved_optimal: bool,
+    /// `Lama`: the work done ([`crate::lazy::Counts::work`]).
+    pub work: u64,
 }
 
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -107,7 +131,7 @@ impl Successors {
 }
 
 /// States stored once in an arena, found by hash.
-struct Registry {
+pub(crate) struct Registry {
     words: usize,
     arena: Vec<u64>,
     table: HashTable<u32>,
@@ -115,7 +139,7 @@ struct Registry {
 }
 
 impl Registry {
-    fn new(words: usize) -> Registry {
+    pub(crate) fn new(words: usize) -> Registry {
         Registry {
             words,
             arena: Vec::new(),
@@ -124,7 +148,7 @@ impl Registry {
         }
     }
 
-    fn get(&self, id: u32) -> &[u64] {
+    pub(crate) fn get(&self, id: u32) -> &[u64] {
         let i = id as usize * self.words;
         &self.arena[i..i + self.words]
     }
@@ -134,7 +158,7 @@ impl Registry {
     }
 
     /// The state's id, and whether it is new.
-    fn insert(&mut self, s: &[u64]) -> (u32, bool) {
+    pub(crate) fn insert(&mut self, s: &[u64]) -> (u32, bool) {
         let h = self.hash(s);
         let (arena, words) = (&self.arena, self.words);
         let at = |id: u32| &arena[id as usize * words..(id as usize + 1) * words];
@@ -203,6 +227,16 @@ impl<'t> Search<'t> {
     pub fn run(&mut self) -> SearchResult {
         let start = Instant::now();
         let r = match self.opts.algorithm {
+            Algorithm::Lama => {
+                let deadline = self.opts.timeout.map(|t| start + t);
+                let (r, any) =
+                    crate::lama::plan(self.task, self.opts.improve, deadline, &mut self.stats);
+                self.stats.heuristic = None;
+                self.stats.iterations = any.iterations;
+                self.stats.first_cost = any.first_cost;
+                self.stats.proved_optimal = any.proved_optimal;
+                r
+            }
             Algorithm::Gbfs => self.gbfs(start),
             Algorithm::Astar => self.astar(start),
         };
@@ -431,7 +465,7 @@ mod tests {
             let opts = Options {
                 algorithm: Algorithm::Astar,
                 heuristic,
-                timeout: None,
+                ..Options::default()
             };
             let mut s = Search::new(&t, opts);
             assert!(matches!(s.run(), SearchResult::Plan(p, 3) if p.len() == 3));

@@ -49,6 +49,9 @@ pub struct Axiom {
 pub struct Task {
     /// Each fact's text, e.g. `(on a b)`.
     pub fact_names: Vec<String>,
+    /// Each fact's predicate (an index into the domain's predicates);
+    /// `u32::MAX` for auxiliary facts.
+    pub fact_preds: Vec<u32>,
     /// Whether a fact is computed by axioms rather than set by operators.
     pub derived: Vec<bool>,
     pub operators: Vec<Operator>,

@@ -85,6 +85,7 @@ fn astar_with_an_admissible_heuristic_finds_the_recorded_optimal_costs() {
         algorithm: Algorithm::Astar,
         heuristic: Heuristic::Max,
         timeout: None,
+        ..Options::default()
     };
     let mut compared = 0;
     for &(domain, problem) in ASTAR_SUBSET {
@@ -137,6 +138,7 @@ fn astar_with_h_max_and_with_blind_search_agree_on_small_problems() {
                     algorithm: Algorithm::Astar,
                     heuristic,
                     timeout: None,
+                    ..Options::default()
                 };
                 l.solve_and_validate(&opts).1
             })
@@ -149,6 +151,7 @@ fn astar_with_h_max_and_with_blind_search_agree_on_small_problems() {
                 algorithm: Algorithm::Astar,
                 heuristic,
                 timeout: None,
+                ..Options::default()
             };
             assert!(l.solve_and_validate(&opts).1 >= costs[0]);
         }
@@ -215,6 +218,7 @@ fn lm_cut_lies_between_h_max_and_the_optimal_cost() {
         algorithm: Algorithm::Astar,
         heuristic: Heuristic::LmCut,
         timeout: None,
+        ..Options::default()
     };
     for (domain, problem) in [("logistics", "p01"), ("depot", "p02"), ("elevators", "p01")] {
         let (d, p) = corpus_case(domain, problem);

@@ -51,6 +51,7 @@ fn the_ariac_part_task_is_the_four_step_plan() {
         algorithm: Algorithm::Astar,
         heuristic: Heuristic::Max,
         timeout: None,
+        ..Options::default()
     };
     let (text, cost, _) = l.solve_and_validate(&opts);
     assert_eq!(
@@ -139,6 +140,7 @@ fn derived_predicates_disjunctions_and_conditional_effects() {
                 algorithm,
                 heuristic,
                 timeout: None,
+                ..Options::default()
             };
             let (text, _, report) = l.solve_and_validate(&opts);
             assert_eq!(
@@ -162,6 +164,7 @@ fn an_unsolvable_problem_is_reported_as_such() {
                 algorithm,
                 heuristic,
                 timeout: None,
+                ..Options::default()
             };
             assert_eq!(l.plan(&opts).unwrap().outcome, Outcome::Unsolvable);
         }

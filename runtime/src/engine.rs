@@ -8,7 +8,7 @@ use crate::controller::{Command, Controller};
 use crate::error::LoadError;
 use crate::faults::FaultRt;
 use crate::kb::{ConditionId, EffectId, FormulaId, Kb};
-use crate::spec::{default_name, Kind, SNode, TreeDoc};
+use crate::spec::{default_name, Amount, Kind, SNode, TreeDoc};
 use btc_ir::{LeafKind, NodeModel, PortValue};
 use btc_pddl::diagnostic::{codes, did_you_mean};
 use btc_pddl::logic::{self, Binding, Effect, Formula, Name, Terms};
@@ -106,6 +106,14 @@ impl Value {
     }
 }
 
+/// A decorator's count or duration: fixed, or read from a blackboard slot
+/// when the node is ticked.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Arg<T> {
+    Fixed(T),
+    Slot(u32),
+}
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) enum Op {
     Sequence,
@@ -118,9 +126,9 @@ pub(crate) enum Op {
     ForceSuccess,
     ForceFailure,
     KeepRunningUntilFailure,
-    Retry(i32),
-    Repeat(i32),
-    Timeout(u64),
+    Retry(Arg<i32>),
+    Repeat(Arg<i32>),
+    Timeout(Arg<u64>),
     SubTree,
     Step(u32),
     AlwaysSuccess,
@@ -795,8 +803,17 @@ impl<'w> Engine<'w> {
                     (_, s) => s,
                 }
             }
-            Op::Retry(n) | Op::Repeat(n) => {
+            Op::Retry(arg) | Op::Repeat(arg) => 'arm: {
                 let retry = matches!(def.op, Op::Retry(_));
+                let what = if retry { "num_attempts" } else { "num_cycles" };
+                let n = match self.amount(arg, what, |n| i32::try_from(n).ok().filter(|n| *n >= -1))
+                {
+                    Ok(n) => n,
+                    Err(r) => {
+                        self.note_failure(i, r);
+                        break 'arm Status::Failure;
+                    }
+                };
                 self.set(iu, Status::Running);
                 let c = self.kid(def, 0);
                 // Retry counts failures and stops at a success; Repeat the
@@ -827,12 +844,22 @@ impl<'w> Engine<'w> {
                     }
                 }
             }
-            Op::Timeout(msec) => {
+            Op::Timeout(arg) => 'arm: {
                 let c = self.kid(def, 0);
                 if self.status[iu] != Status::Running {
+                    // Read when the timeout starts, as BT.CPP does.
+                    let msec = match self.amount(arg, "msec", |n| u64::try_from(n).ok()) {
+                        Ok(ms) => ms,
+                        Err(r) => {
+                            self.note_failure(i, r);
+                            break 'arm Status::Failure;
+                        }
+                    };
                     self.set(iu, Status::Running);
                     self.aux[iu] = self.now_ms.saturating_add(msec);
+                    self.cur[iu] = u32::try_from(msec).unwrap_or(u32::MAX);
                 }
+                let msec = self.cur[iu];
                 if msec > 0
                     && self.now_ms >= self.aux[iu]
                     && self.status[c as usize] == Status::Running
@@ -1158,6 +1185,28 @@ impl<'w> Engine<'w> {
         }
     }
 
+    /// A decorator's count: fixed, or read from its blackboard slot (a fault
+    /// reason when the entry holds no number the decorator takes).
+    fn amount<T: Copy>(
+        &self,
+        a: Arg<T>,
+        port: &str,
+        fit: impl Fn(i64) -> Option<T>,
+    ) -> Result<T, Reason> {
+        match a {
+            Arg::Fixed(n) => Ok(n),
+            Arg::Slot(s) => {
+                let v = &self.bb[s as usize];
+                v.as_int().and_then(fit).ok_or_else(|| {
+                    Reason::Plain(format!(
+                        "`{port}` reads `{}` from the blackboard, which is not a number it takes",
+                        v.text()
+                    ))
+                })
+            }
+        }
+    }
+
     #[inline]
     fn read(&self, port: u32) -> &Value {
         let p = &self.ports[port as usize];
@@ -1464,9 +1513,9 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
             Kind::ForceSuccess => Op::ForceSuccess,
             Kind::ForceFailure => Op::ForceFailure,
             Kind::KeepRunningUntilFailure => Op::KeepRunningUntilFailure,
-            Kind::Retry(k) => Op::Retry(*k),
-            Kind::Repeat(k) => Op::Repeat(*k),
-            Kind::Timeout(ms) => Op::Timeout(*ms),
+            Kind::Retry(k) => Op::Retry(self.arg(k, scope)),
+            Kind::Repeat(k) => Op::Repeat(self.arg(k, scope)),
+            Kind::Timeout(ms) => Op::Timeout(self.arg(ms, scope)),
             Kind::SubTree { .. } => {
                 id = "SubTree".into();
                 Op::SubTree
@@ -1665,6 +1714,14 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
         st.pre_over_all = over_all;
         st.pre_end = pre_end;
         Ok(())
+    }
+
+    /// A decorator's count: fixed, or the slot of the blackboard entry it reads.
+    fn arg<T: Copy>(&mut self, a: &Amount<T>, scope: &mut Scope) -> Arg<T> {
+        match a {
+            Amount::Fixed(n) => Arg::Fixed(*n),
+            Amount::Entry(key) => Arg::Slot(self.slot_in(scope, key)),
+        }
     }
 
     fn slot_in(&mut self, scope: &mut Scope, key: &str) -> u32 {

@@ -1,7 +1,7 @@
 //! A loaded tree before compilation: what the JSON IR and the XML loader
 //! both produce, so the two run through one builder (and give one trace).
 
-use btc_ir::{ControlKind, DecoratorKind};
+use btc_ir::{ControlKind, Count, DecoratorKind};
 use btc_ir::{LeafKind, Node, NodeModel, PortValue, StepInfo, TreeIr};
 
 /// What a node does. Thresholds and counts are BT.CPP's: `-1` means "all
@@ -21,9 +21,9 @@ pub enum Kind {
     ForceSuccess,
     ForceFailure,
     KeepRunningUntilFailure,
-    Retry(i32),
-    Repeat(i32),
-    Timeout(u64),
+    Retry(Amount<i32>),
+    Repeat(Amount<i32>),
+    Timeout(Amount<u64>),
     /// A call of a tree with port remapping.
     SubTree {
         id: String,
@@ -43,6 +43,15 @@ pub enum Kind {
         kind: Option<LeafKind>,
         ports: Vec<(String, PortValue)>,
     },
+}
+
+/// A decorator's count or duration: written out, or read from a
+/// blackboard entry (`{key}`, a port of the enclosing tree) each time the
+/// node is ticked, as BT.CPP reads it.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Amount<T> {
+    Fixed(T),
+    Entry(String),
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -144,9 +153,9 @@ pub fn from_node(n: &Node) -> SNode {
             child,
         } => (
             match decorator {
-                DecoratorKind::Retry { times } => Kind::Retry(clamp(*times)),
-                DecoratorKind::Repeat { times } => Kind::Repeat(clamp(*times)),
-                DecoratorKind::Timeout { ms } => Kind::Timeout(*ms),
+                DecoratorKind::Retry { times } => Kind::Retry(amount(times, clamp)),
+                DecoratorKind::Repeat { times } => Kind::Repeat(amount(times, clamp)),
+                DecoratorKind::Timeout { ms } => Kind::Timeout(amount(ms, |n| n)),
                 DecoratorKind::Inverter => Kind::Inverter,
                 DecoratorKind::ForceSuccess => Kind::ForceSuccess,
                 DecoratorKind::ForceFailure => Kind::ForceFailure,
@@ -195,8 +204,15 @@ pub fn from_node(n: &Node) -> SNode {
     }
 }
 
-fn clamp(n: u32) -> i32 {
-    i32::try_from(n).unwrap_or(i32::MAX)
+fn clamp(n: impl TryInto<i32>) -> i32 {
+    n.try_into().unwrap_or(i32::MAX)
+}
+
+fn amount<T>(c: &Count, fixed: impl Fn(u64) -> T) -> Amount<T> {
+    match c {
+        Count::Fixed(n) => Amount::Fixed(fixed(*n)),
+        Count::Param { param } => Amount::Entry(param.clone()),
+    }
 }
 
 /// The name BT.CPP gives a node without a `name`: its registration ID.

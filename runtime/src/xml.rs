@@ -7,7 +7,7 @@
 
 use crate::engine::MAX_DEPTH;
 use crate::error::LoadError;
-use crate::spec::{Kind, SNode, TreeDoc};
+use crate::spec::{Amount, Kind, SNode, TreeDoc};
 use btc_ir::{LeafKind, NodeModel, PortDirection, PortModel, PortValue};
 use btc_pddl::diagnostic::codes;
 use btc_pddl::logic::decode;
@@ -65,6 +65,13 @@ impl Elem {
         }
     }
 
+    /// `k="{key}"`: the blackboard entry the attribute reads.
+    fn entry(&self, k: &str) -> Option<String> {
+        let v = self.get(k)?.trim();
+        let key = v.strip_prefix('{')?.strip_suffix('}')?;
+        (!key.is_empty()).then(|| key.to_owned())
+    }
+
     fn count(&self, k: &str, default: Option<i64>) -> Result<i32, LoadError> {
         let n = self.int(k, default)?;
         i32::try_from(n).ok().filter(|n| *n >= -1).ok_or_else(|| {
@@ -113,14 +120,24 @@ fn node_of(mut e: Elem) -> Result<SNode, LoadError> {
         "ForceSuccess" => Kind::ForceSuccess,
         "ForceFailure" => Kind::ForceFailure,
         "KeepRunningUntilFailure" => Kind::KeepRunningUntilFailure,
-        "RetryUntilSuccessful" => Kind::Retry(e.count("num_attempts", None)?),
-        "Repeat" => Kind::Repeat(e.count("num_cycles", None)?),
-        "Timeout" => {
-            let ms = e.int("msec", None)?;
-            Kind::Timeout(u64::try_from(ms).map_err(|_| {
-                LoadError::new(codes::X_BAD_PORT, "<Timeout>: `msec` must not be negative").at(e.at)
-            })?)
-        }
+        "RetryUntilSuccessful" => Kind::Retry(match e.entry("num_attempts") {
+            Some(k) => Amount::Entry(k),
+            None => Amount::Fixed(e.count("num_attempts", None)?),
+        }),
+        "Repeat" => Kind::Repeat(match e.entry("num_cycles") {
+            Some(k) => Amount::Entry(k),
+            None => Amount::Fixed(e.count("num_cycles", None)?),
+        }),
+        "Timeout" => Kind::Timeout(match e.entry("msec") {
+            Some(k) => Amount::Entry(k),
+            None => {
+                let ms = e.int("msec", None)?;
+                Amount::Fixed(u64::try_from(ms).map_err(|_| {
+                    LoadError::new(codes::X_BAD_PORT, "<Timeout>: `msec` must not be negative")
+                        .at(e.at)
+                })?)
+            }
+        }),
         "SubTree" => {
             let id = e.get("ID").ok_or_else(|| {
                 LoadError::new(codes::X_BAD_PORT, "<SubTree> needs the attribute `ID`").at(e.at)

@@ -147,7 +147,7 @@ fn halted_leaves_commands_still_run_once_and_are_not_waited_for() {
         at: None,
     };
     let root = SNode {
-        kind: Kind::Repeat(3),
+        kind: Kind::Repeat(btc_runtime::spec::Amount::Fixed(3)),
         name: None,
         children: vec![par],
         at: None,

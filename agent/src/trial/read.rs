@@ -9,6 +9,14 @@ use btc_pddl::diagnostic::{codes, did_you_mean, Code, Diagnostic};
 use btc_pddl::source::{FileId, Span};
 use std::collections::BTreeMap;
 
+/// The fields that say when an announcement or a challenge happens; one of
+/// them is given.
+const CONDITION_FIELDS: [&str; 3] = [
+    "time_condition",
+    "part_place_condition",
+    "submission_condition",
+];
+
 /// Reads a trial file's text. `None` when it is not YAML or its top level
 /// is not a mapping; otherwise the trial with whatever could be read, and
 /// the diagnostics (errors mean the trial should not run).
@@ -738,12 +746,11 @@ impl Reader {
 
     /// A condition: in `f` directly (challenges) or under `announcement`.
     fn condition(&mut self, f: &mut Fields<'_>, what: &str) -> Option<Condition> {
-        let keys = [
-            "time_condition",
-            "part_place_condition",
-            "submission_condition",
-        ];
-        let given: Vec<&str> = keys.iter().copied().filter(|k| f.has(k)).collect();
+        let given: Vec<&str> = CONDITION_FIELDS
+            .iter()
+            .copied()
+            .filter(|k| f.has(k))
+            .collect();
         if given.len() > 1 {
             let n = f.get(given[1]).expect("present");
             self.error(
@@ -838,169 +845,15 @@ impl Reader {
                     continue;
                 };
                 let what = format!("the `{kind}` challenge");
-                let Some(mut f) = self.fields(v, &what) else {
+                let Some(f) = self.fields(v, &what) else {
                     continue;
                 };
                 let c = match *kind {
-                    "faulty_part" => {
-                        let id = self
-                            .need(&mut f, "order_id")
-                            .and_then(|n| self.text(n, "an order id"))
-                            .map(str::to_owned);
-                        let mut q = [false; 4];
-                        for (k, slot) in q.iter_mut().enumerate() {
-                            if let Some(n) = f.get(&format!("quadrant{}", k + 1)) {
-                                *slot = self.boolean(n, "a quadrant flag").unwrap_or(false);
-                            }
-                        }
-                        self.done(
-                            f,
-                            &[
-                                "order_id",
-                                "quadrant1",
-                                "quadrant2",
-                                "quadrant3",
-                                "quadrant4",
-                            ],
-                        );
-                        id.map(|order_id| ChallengeKind::FaultyPart {
-                            order_id,
-                            quadrants: q,
-                        })
-                    }
-                    "dropped_part" => {
-                        let robot = self.need(&mut f, "robot").and_then(|n| self.robot(n));
-                        let kind = self.kind(&mut f);
-                        let after = self
-                            .need(&mut f, "drop_after")
-                            .and_then(|n| self.int(n, "`drop_after`", 0, 1000));
-                        let delay = self
-                            .need(&mut f, "delay")
-                            .and_then(|n| self.seconds(n, "`delay`"));
-                        self.done(f, &["robot", "type", "color", "drop_after", "delay"]);
-                        match (robot, kind, after, delay) {
-                            (Some(robot), Some(kind), Some(a), Some(delay)) => {
-                                Some(ChallengeKind::DroppedPart {
-                                    robot,
-                                    kind,
-                                    drop_after: a as u32,
-                                    delay,
-                                })
-                            }
-                            _ => None,
-                        }
-                    }
-                    "robot_malfunction" => {
-                        let duration = self
-                            .need(&mut f, "duration")
-                            .and_then(|n| self.seconds(n, "`duration`"));
-                        let mut robots = Vec::new();
-                        if let Some(list) = self
-                            .need(&mut f, "robots_to_disable")
-                            .and_then(|n| self.list(n, "`robots_to_disable`"))
-                        {
-                            for r in list {
-                                if let Some(r) = self.robot(r) {
-                                    if !robots.contains(&r) {
-                                        robots.push(r);
-                                    }
-                                }
-                            }
-                        }
-                        let cond = self.condition(&mut f, &what);
-                        self.done(
-                            f,
-                            &[
-                                "duration",
-                                "robots_to_disable",
-                                "time_condition",
-                                "part_place_condition",
-                                "submission_condition",
-                            ],
-                        );
-                        match (duration, cond) {
-                            (Some(duration), Some(condition)) => {
-                                Some(ChallengeKind::RobotMalfunction {
-                                    duration,
-                                    robots,
-                                    condition,
-                                })
-                            }
-                            _ => None,
-                        }
-                    }
-                    "sensor_blackout" => {
-                        let duration = self
-                            .need(&mut f, "duration")
-                            .and_then(|n| self.seconds(n, "`duration`"));
-                        let mut sensors = Vec::new();
-                        if let Some(list) = self
-                            .need(&mut f, "sensors_to_disable")
-                            .and_then(|n| self.list(n, "`sensors_to_disable`"))
-                        {
-                            for s in list {
-                                if let Some(s) = self.choice(s, "a sensor type", &SENSOR_TYPES) {
-                                    if !sensors.iter().any(|x: &String| x == s) {
-                                        sensors.push(s.to_owned());
-                                    }
-                                }
-                            }
-                        }
-                        let cond = self.condition(&mut f, &what);
-                        self.done(
-                            f,
-                            &[
-                                "duration",
-                                "sensors_to_disable",
-                                "time_condition",
-                                "part_place_condition",
-                                "submission_condition",
-                            ],
-                        );
-                        match (duration, cond) {
-                            (Some(duration), Some(condition)) => {
-                                Some(ChallengeKind::SensorBlackout {
-                                    duration,
-                                    sensors,
-                                    condition,
-                                })
-                            }
-                            _ => None,
-                        }
-                    }
-                    _ => {
-                        let behavior = self
-                            .need(&mut f, "behavior")
-                            .and_then(|n| {
-                                self.choice(
-                                    n,
-                                    "a human behavior",
-                                    &["indifferent", "antagonistic", "helpful"],
-                                )
-                            })
-                            .map(|b| match b {
-                                "antagonistic" => Behavior::Antagonistic,
-                                "helpful" => Behavior::Helpful,
-                                _ => Behavior::Indifferent,
-                            });
-                        let cond = self.condition(&mut f, &what);
-                        self.done(
-                            f,
-                            &[
-                                "behavior",
-                                "time_condition",
-                                "part_place_condition",
-                                "submission_condition",
-                            ],
-                        );
-                        match (behavior, cond) {
-                            (Some(behavior), Some(condition)) => Some(ChallengeKind::Human {
-                                behavior,
-                                condition,
-                            }),
-                            _ => None,
-                        }
-                    }
+                    "faulty_part" => self.faulty_part(f),
+                    "dropped_part" => self.dropped_part(f),
+                    "robot_malfunction" => self.robot_malfunction(f, &what),
+                    "sensor_blackout" => self.sensor_blackout(f, &what),
+                    _ => self.human(f, &what),
                 };
                 if let Some(kind) = c {
                     out.push(Challenge {
@@ -1011,6 +864,136 @@ impl Reader {
             }
         }
         out
+    }
+
+    fn faulty_part(&mut self, mut f: Fields<'_>) -> Option<ChallengeKind> {
+        let id = self
+            .need(&mut f, "order_id")
+            .and_then(|n| self.text(n, "an order id"))
+            .map(str::to_owned);
+        let mut q = [false; 4];
+        for (k, slot) in q.iter_mut().enumerate() {
+            if let Some(n) = f.get(&format!("quadrant{}", k + 1)) {
+                *slot = self.boolean(n, "a quadrant flag").unwrap_or(false);
+            }
+        }
+        self.done(
+            f,
+            &[
+                "order_id",
+                "quadrant1",
+                "quadrant2",
+                "quadrant3",
+                "quadrant4",
+            ],
+        );
+        Some(ChallengeKind::FaultyPart {
+            order_id: id?,
+            quadrants: q,
+        })
+    }
+
+    fn dropped_part(&mut self, mut f: Fields<'_>) -> Option<ChallengeKind> {
+        let robot = self.need(&mut f, "robot").and_then(|n| self.robot(n));
+        let kind = self.kind(&mut f);
+        let after = self
+            .need(&mut f, "drop_after")
+            .and_then(|n| self.int(n, "`drop_after`", 0, 1000));
+        let delay = self
+            .need(&mut f, "delay")
+            .and_then(|n| self.seconds(n, "`delay`"));
+        self.done(f, &["robot", "type", "color", "drop_after", "delay"]);
+        Some(ChallengeKind::DroppedPart {
+            robot: robot?,
+            kind: kind?,
+            drop_after: after? as u32,
+            delay: delay?,
+        })
+    }
+
+    fn robot_malfunction(&mut self, mut f: Fields<'_>, what: &str) -> Option<ChallengeKind> {
+        let duration = self.duration(&mut f);
+        let robots = self.distinct(&mut f, "robots_to_disable", |r, n| r.robot(n));
+        let condition = self.condition(&mut f, what);
+        self.done_conditional(f, &["duration", "robots_to_disable"]);
+        Some(ChallengeKind::RobotMalfunction {
+            duration: duration?,
+            robots,
+            condition: condition?,
+        })
+    }
+
+    fn sensor_blackout(&mut self, mut f: Fields<'_>, what: &str) -> Option<ChallengeKind> {
+        let duration = self.duration(&mut f);
+        let sensors = self.distinct(&mut f, "sensors_to_disable", |r, n| {
+            r.choice(n, "a sensor type", &SENSOR_TYPES)
+                .map(str::to_owned)
+        });
+        let condition = self.condition(&mut f, what);
+        self.done_conditional(f, &["duration", "sensors_to_disable"]);
+        Some(ChallengeKind::SensorBlackout {
+            duration: duration?,
+            sensors,
+            condition: condition?,
+        })
+    }
+
+    fn human(&mut self, mut f: Fields<'_>, what: &str) -> Option<ChallengeKind> {
+        let behavior = self
+            .need(&mut f, "behavior")
+            .and_then(|n| {
+                self.choice(
+                    n,
+                    "a human behavior",
+                    &["indifferent", "antagonistic", "helpful"],
+                )
+            })
+            .map(|b| match b {
+                "antagonistic" => Behavior::Antagonistic,
+                "helpful" => Behavior::Helpful,
+                _ => Behavior::Indifferent,
+            });
+        let condition = self.condition(&mut f, what);
+        self.done_conditional(f, &["behavior"]);
+        Some(ChallengeKind::Human {
+            behavior: behavior?,
+            condition: condition?,
+        })
+    }
+
+    fn duration(&mut self, f: &mut Fields<'_>) -> Option<f64> {
+        self.need(f, "duration")
+            .and_then(|n| self.seconds(n, "`duration`"))
+    }
+
+    /// The distinct values of the list under `key`, in order; a repeated
+    /// value counts once (the competition's reader does the same).
+    fn distinct<T: PartialEq>(
+        &mut self,
+        f: &mut Fields<'_>,
+        key: &str,
+        mut each: impl FnMut(&mut Self, &Node) -> Option<T>,
+    ) -> Vec<T> {
+        let mut out = Vec::new();
+        let what = format!("`{key}`");
+        if let Some(list) = self.need(f, key).and_then(|n| self.list(n, &what)) {
+            for n in list {
+                if let Some(v) = each(self, n) {
+                    if !out.contains(&v) {
+                        out.push(v);
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// `done` for a challenge that starts on a condition: `known` plus the
+    /// three condition fields.
+    fn done_conditional(&mut self, f: Fields<'_>, known: &[&str]) {
+        let mut all = known.to_vec();
+        all.extend(CONDITION_FIELDS);
+        self.done(f, &all);
     }
 
     fn orders(&mut self, node: &Node) -> Vec<Order> {

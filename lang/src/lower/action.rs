@@ -53,3 +53,41 @@ impl ActionLogic {
         }
     }
 }
+
+/// A rule's `effect`, in the rule's variables, converted once per rule.
+pub(super) struct RuleEffect {
+    effect: Effect,
+}
+
+impl RuleEffect {
+    pub fn new(e: &btc_pddl::ast::Effect) -> RuleEffect {
+        RuleEffect {
+            effect: Effect::from_ast(e),
+        }
+    }
+
+    /// The effect with the step's objects for the rule's variables (`None`
+    /// when it changes nothing); `Err` names a variable the step leaves
+    /// unbound (an optional parameter it does not give).
+    pub fn ground(
+        &self,
+        bindings: &crate::rules::matching::Bindings,
+    ) -> Result<Option<Effect>, Name> {
+        let params: Vec<Name> = bindings
+            .iter()
+            .map(|(v, _)| btc_pddl::logic::name(v))
+            .collect();
+        let objects: Vec<Name> = bindings
+            .iter()
+            .map(|(_, o)| btc_pddl::logic::name(o))
+            .collect();
+        let e = self.effect.ground(&Binding {
+            params: &params,
+            objects: &objects,
+        });
+        if let Some(v) = e.free_vars().into_iter().next() {
+            return Err(v);
+        }
+        Ok(Effect::conjunction(vec![e]))
+    }
+}

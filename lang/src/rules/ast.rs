@@ -2,16 +2,31 @@
 //! own start (see [`ItemNode::offset`]), so editing one item leaves the
 //! others' trees equal — the incremental checker relies on that.
 
-pub use btc_ir::{ControlKind, DecoratorKind};
+pub use super::name::Key;
+pub use btc_ir::ControlKind;
 use btc_pddl::ast::{Effect, Formula};
 use btc_pddl::source::Span;
 use serde::{Deserialize, Serialize};
 
-/// A name as written (case kept: node names are CamelCase).
+/// A name as written (case kept: node names are CamelCase) and its folded
+/// [`Key`]. Names the language compares case-sensitively (nodes, trees,
+/// tables, ports, captures) compare by `text`; names of PDDL things (types,
+/// objects, action-name parts) and table keys compare by `key`.
 #[derive(Clone, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub struct Ident {
     pub text: String,
+    pub key: Key,
     pub span: Span,
+}
+
+impl Ident {
+    pub fn new(text: String, span: Span) -> Ident {
+        Ident {
+            key: Key::new(&text),
+            text,
+            span,
+        }
+    }
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -132,8 +147,15 @@ pub struct TableDecl {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "lowercase")]
 pub enum NamePart {
-    Lit { text: String, span: Span },
-    Capture { name: Ident },
+    /// Literal characters, as written and folded (they match case-insensitively).
+    Lit {
+        text: String,
+        key: Key,
+        span: Span,
+    },
+    Capture {
+        name: Ident,
+    },
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -153,12 +175,18 @@ pub struct Pattern {
 }
 
 impl Pattern {
-    /// The literal action name when the pattern has no capture.
-    pub fn literal_name(&self) -> Option<String> {
+    /// The literal action name (folded) when the pattern has no capture.
+    pub fn literal_name(&self) -> Option<&Key> {
         match self.name.as_slice() {
-            [NamePart::Lit { text, .. }] => Some(text.to_lowercase()),
+            [NamePart::Lit { key, .. }] => Some(key),
             _ => None,
         }
+    }
+
+    /// The pattern as written, folded: what "did you mean" compares with
+    /// the domain's action names.
+    pub fn name_key(&self) -> Key {
+        Key::new(&self.name_text())
     }
 
     pub fn name_span(&self) -> Span {
@@ -186,17 +214,43 @@ fn part_span(p: &NamePart) -> Span {
     }
 }
 
+/// One side of an `==` / `!=` guard.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum Operand {
+    /// `?x`: the object the step binds to it.
+    Var { name: Ident },
+    /// `"floor_robot"`: an object or constant, by name (`name.span` is the
+    /// string's, quotes included).
+    Object { name: Ident },
+}
+
+impl Operand {
+    pub fn span(&self) -> Span {
+        match self {
+            Operand::Var { name } | Operand::Object { name } => name.span,
+        }
+    }
+
+    pub fn var(&self) -> Option<&Ident> {
+        match self {
+            Operand::Var { name } => Some(name),
+            Operand::Object { .. } => None,
+        }
+    }
+}
+
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "kebab-case")]
 pub enum Guard {
     Ne {
-        left: Ident,
-        right: Ident,
+        left: Operand,
+        right: Operand,
         span: Span,
     },
     Eq {
-        left: Ident,
-        right: Ident,
+        left: Operand,
+        right: Operand,
         span: Span,
     },
     /// `?x - type`
@@ -295,6 +349,96 @@ impl Value {
     }
 }
 
+/// The decorators of the language, by keyword.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DecoratorName {
+    Retry,
+    Repeat,
+    Timeout,
+    Inverter,
+    ForceSuccess,
+    ForceFailure,
+}
+
+/// A decorator's parameter: its name (as BT.CPP's port is called, or
+/// shorter) and the whole numbers it takes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DecoratorParam {
+    pub name: &'static str,
+    /// What the number counts, for messages.
+    pub what: &'static str,
+    pub min: i64,
+    pub max: i64,
+}
+
+impl DecoratorName {
+    pub const ALL: &'static [DecoratorName] = &[
+        DecoratorName::Retry,
+        DecoratorName::Repeat,
+        DecoratorName::Timeout,
+        DecoratorName::Inverter,
+        DecoratorName::ForceSuccess,
+        DecoratorName::ForceFailure,
+    ];
+
+    pub fn keyword(self) -> &'static str {
+        match self {
+            DecoratorName::Retry => "retry",
+            DecoratorName::Repeat => "repeat",
+            DecoratorName::Timeout => "timeout",
+            DecoratorName::Inverter => "inverter",
+            DecoratorName::ForceSuccess => "force_success",
+            DecoratorName::ForceFailure => "force_failure",
+        }
+    }
+
+    pub fn from_keyword(word: &str) -> Option<DecoratorName> {
+        DecoratorName::ALL
+            .iter()
+            .copied()
+            .find(|d| d.keyword() == word)
+    }
+
+    /// The one parameter of `retry`, `repeat` and `timeout`. BT.CPP reads
+    /// the counts as `int` and the duration as `unsigned`; 0 would never
+    /// run the child.
+    pub fn param(self) -> Option<DecoratorParam> {
+        match self {
+            DecoratorName::Retry => Some(DecoratorParam {
+                name: "times",
+                what: "attempts",
+                min: 1,
+                max: i32::MAX as i64,
+            }),
+            DecoratorName::Repeat => Some(DecoratorParam {
+                name: "times",
+                what: "repetitions",
+                min: 1,
+                max: i32::MAX as i64,
+            }),
+            DecoratorName::Timeout => Some(DecoratorParam {
+                name: "msec",
+                what: "milliseconds",
+                min: 1,
+                max: u32::MAX as i64,
+            }),
+            DecoratorName::Inverter | DecoratorName::ForceSuccess | DecoratorName::ForceFailure => {
+                None
+            }
+        }
+    }
+}
+
+/// A decorator's argument, by position (`retry(3)`) or by its parameter's
+/// name (`timeout(msec: ?t)`). It takes the values a port takes.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DecoratorArg {
+    pub param: Option<Ident>,
+    pub value: Value,
+    pub span: Span,
+}
+
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Arg {
     pub port: Ident,
@@ -311,7 +455,9 @@ pub enum Template {
         span: Span,
     },
     Decorator {
-        decorator: DecoratorKind,
+        decorator: DecoratorName,
+        /// `(3)`, `(msec: ?t)`: checked against the decorator's parameter.
+        args: Vec<DecoratorArg>,
         name: Option<StrLit>,
         child: Box<Template>,
         span: Span,

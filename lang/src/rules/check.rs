@@ -1,10 +1,13 @@
 //! Checks of `.btrules` items against their declarations and the PDDL
 //! domain. [`check_item`] looks at one item (spans relative to it: the
-//! incremental database calls it per item); [`check_file`] does what needs
-//! the whole file (duplicates, coverage, shadowing, unused names).
+//! incremental database calls it per item); what needs the whole file
+//! (duplicates, coverage, shadowing, unused names) is in `file_checks`.
 
+use super::actions::ActionIndex;
 use super::ast::*;
-use super::matching::{bind_params, match_name};
+use super::matching::Captures;
+use super::name::{capture_value, Key};
+use super::reach::{reach, Never, Verdict};
 use btc_pddl::ast::{Domain, Effect, Formula};
 use btc_pddl::check::{check_effect_in, check_formula_in, DomainIndex, ProblemIndex};
 use btc_pddl::diagnostic::{closest, codes, Diagnostic};
@@ -67,6 +70,8 @@ pub struct DomainCtx<'a> {
     pub domain: &'a Domain,
     pub index: &'a DomainIndex,
     pub problem: Option<&'a ProblemIndex>,
+    /// The domain's action names, indexed for patterns.
+    pub actions: &'a ActionIndex,
 }
 
 pub const BASIC_TYPES: &[&str] = &["string", "int", "float", "bool"];
@@ -92,6 +97,8 @@ struct Tcx<'a> {
     vars: Vec<(String, Option<Vec<TypeId>>)>,
     /// Captures in scope and the values they take in the domain's actions.
     captures: Vec<(String, Vec<String>)>,
+    /// Tree ports of basic types (`int`, `string`, ...), as variables.
+    basic: Vec<(String, VType)>,
     in_plan: bool,
     diags: Vec<Diagnostic>,
 }
@@ -133,6 +140,7 @@ impl Tcx<'_> {
             }
             Template::Decorator {
                 decorator,
+                args,
                 name,
                 child,
                 span,
@@ -140,18 +148,7 @@ impl Tcx<'_> {
                 if let Some(n) = name {
                     self.string(n);
                 }
-                if matches!(
-                    decorator,
-                    DecoratorKind::Retry { times: 0 }
-                        | DecoratorKind::Repeat { times: 0 }
-                        | DecoratorKind::Timeout { ms: 0 }
-                ) {
-                    self.err(Diagnostic::error(
-                        codes::R_BAD_ARGUMENT,
-                        *span,
-                        format!("`{}(0)` never runs its child", decorator.keyword()),
-                    ));
-                }
+                self.decorator_args(*decorator, args, *span);
                 self.template(child);
             }
             Template::Call { name, args, span } => self.call(name, args, *span),
@@ -262,6 +259,154 @@ impl Tcx<'_> {
         }
     }
 
+    /// A decorator's arguments against its parameter: one value (by
+    /// position or by the parameter's name) that is a whole number in the
+    /// parameter's range, or none for decorators without a parameter.
+    fn decorator_args(&mut self, d: DecoratorName, args: &[DecoratorArg], span: Span) {
+        let word = d.keyword();
+        let Some(param) = d.param() else {
+            if let Some(a) = args.first() {
+                self.value(&a.value);
+                self.err(
+                    Diagnostic::error(
+                        codes::R_BAD_ARGUMENT,
+                        a.span,
+                        format!("`{word}` takes no argument"),
+                    )
+                    .with_hint(format!("write `{word}` and then the node it decorates")),
+                );
+            }
+            return;
+        };
+        let Some(arg) = args.first() else {
+            self.err(
+                Diagnostic::error(
+                    codes::R_BAD_ARGUMENT,
+                    span,
+                    format!("`{word}` needs its number of {}", param.what),
+                )
+                .with_hint(format!(
+                    "write `{word}(3) ...` or `{word}({}: ...) ...`",
+                    param.name
+                )),
+            );
+            return;
+        };
+        for extra in &args[1..] {
+            self.value(&extra.value);
+            self.err(Diagnostic::error(
+                codes::R_BAD_ARGUMENT,
+                extra.span,
+                format!("`{word}` takes one argument, its `{}`", param.name),
+            ));
+        }
+        if let Some(p) = arg.param.as_ref().filter(|p| p.text != param.name) {
+            self.err(
+                Diagnostic::error(
+                    codes::R_BAD_ARGUMENT,
+                    p.span,
+                    format!(
+                        "`{word}` has no parameter `{}`; its parameter is `{}`",
+                        p.text, param.name
+                    ),
+                )
+                .with_fix(
+                    format!("change to `{}`", param.name),
+                    p.span,
+                    param.name,
+                ),
+            );
+        }
+        let vt = self.value(&arg.value);
+        let range = |n: i64| n >= param.min && n <= param.max;
+        let out_of_range = |n: i64| {
+            Diagnostic::error(
+                codes::R_BAD_ARGUMENT,
+                arg.value.span(),
+                if n < param.min {
+                    format!(
+                        "`{word}({n})` never runs its child: it needs at least {} {}",
+                        param.min, param.what
+                    )
+                } else {
+                    format!("`{word}` takes at most {} {}", param.max, param.what)
+                },
+            )
+        };
+        match (&arg.value, vt) {
+            (Value::Int { value, .. }, _) if !range(*value) => self.err(out_of_range(*value)),
+            (_, VType::Int | VType::Unknown) => {}
+            // A capture of digits (`wait_{ms}` matching `wait_30`) is a number.
+            (Value::Name { name }, _)
+                if self
+                    .capture_values(name)
+                    .is_some_and(|vs| vs.iter().all(|v| v.parse::<i64>().is_ok_and(range))) => {}
+            (value, vt) => {
+                let what = describe_vtype(&vt, self.ctx);
+                self.err(
+                    Diagnostic::error(
+                        codes::R_PORT_TYPE,
+                        value.span(),
+                        format!(
+                            "`{word}`'s `{}` takes a whole number of {}, but this is {what}",
+                            param.name, param.what
+                        ),
+                    )
+                    .with_hint("a number, a table lookup with numbers, a capture of digits, or an `int` port of a tree"),
+                );
+            }
+        }
+        // The table values a lookup can give must be in range too.
+        if let Value::Lookup { table, key, .. } = &arg.value {
+            let keys: Option<Vec<Key>> = match &**key {
+                Value::Name { name } => self
+                    .capture_values(name)
+                    .map(|vs| vs.iter().map(|v| Key::new(v)).collect()),
+                Value::Str { value } => value.plain().map(|k| vec![Key::new(&k)]),
+                _ => None,
+            };
+            let bad: Vec<String> = self
+                .decls
+                .tables
+                .get(&table.text)
+                .map(|t| {
+                    t.entries
+                        .iter()
+                        .filter(|e| keys.as_ref().is_none_or(|ks| ks.contains(&e.key.key)))
+                        .filter_map(|e| match &e.value {
+                            Literal::Int { value, .. } if !range(*value) => {
+                                Some(format!("{value} for `{}`", e.key.text))
+                            }
+                            _ => None,
+                        })
+                        .collect()
+                })
+                .unwrap_or_default();
+            if !bad.is_empty() {
+                self.err(Diagnostic::error(
+                    codes::R_BAD_ARGUMENT,
+                    arg.value.span(),
+                    format!(
+                        "table `{}` can give `{word}` {}, outside its range {} to {}",
+                        table.text,
+                        bad.join(", "),
+                        param.min,
+                        param.max
+                    ),
+                ));
+            }
+        }
+    }
+
+    /// The values a capture takes over the domain's actions (`None` when it
+    /// is not a capture of this rule).
+    fn capture_values(&self, name: &Ident) -> Option<&[String]> {
+        self.captures
+            .iter()
+            .find(|(c, _)| *c == name.text)
+            .map(|(_, v)| v.as_slice())
+    }
+
     fn string(&mut self, s: &StrLit) {
         for p in &s.parts {
             match p {
@@ -320,7 +465,13 @@ impl Tcx<'_> {
 
     fn value(&mut self, v: &Value) -> VType {
         match v {
-            Value::Var { name } => self.var(name).map_or(VType::Unknown, VType::Objects),
+            Value::Var { name } => {
+                let objects = self.var(name);
+                match self.basic.iter().find(|(v, _)| *v == name.text) {
+                    Some((_, t)) => t.clone(),
+                    None => objects.map_or(VType::Unknown, VType::Objects),
+                }
+            }
             Value::Str { value } => {
                 self.string(value);
                 match value.plain() {
@@ -356,7 +507,7 @@ impl Tcx<'_> {
             self.value(key);
             return VType::Unknown;
         };
-        let has = |k: &str| t.entries.iter().any(|e| e.key.text.eq_ignore_ascii_case(k));
+        let has = |k: &str| t.entries.iter().any(|e| e.key.key == Key::new(k));
         let keys = || {
             t.entries
                 .iter()
@@ -372,7 +523,7 @@ impl Tcx<'_> {
                             Diagnostic::error(
                                 codes::R_UNKNOWN_KEY,
                                 span,
-                                format!("table `{}` has no key `{}` (the capture `{}` takes it for a domain action)", table.text, val.to_uppercase(), name.text),
+                                format!("table `{}` has no key `{}` (the capture `{}` takes it for a domain action)", table.text, capture_value(val), name.text),
                             )
                             .with_hint(format!("its keys are {}; add the key, or guard the rule with `where {} in {}`", keys(), name.text, table.text)),
                         );
@@ -406,17 +557,7 @@ impl Tcx<'_> {
 
     fn port_fit(&mut self, port: &PortDecl, value: &Value, vt: VType) {
         let ty = port.ty.text.as_str();
-        let describe = |vt: &VType, ctx: Option<DomainCtx>| match vt {
-            VType::Objects(t) => match ctx {
-                Some(c) => format!("an object of type `{}`", c.index.types.display(t)),
-                None => "an object".to_owned(),
-            },
-            VType::Name(_) | VType::Str => "a string".to_owned(),
-            VType::Int => "an int".to_owned(),
-            VType::Float => "a float".to_owned(),
-            VType::Bool => "a bool".to_owned(),
-            VType::Unknown => "a value".to_owned(),
-        };
+        let pddl_ty = port.ty.key.as_str();
         let ok = match (ty, &vt) {
             (_, VType::Unknown) => true,
             ("string", _) => true,
@@ -426,20 +567,20 @@ impl Tcx<'_> {
             ("int" | "float" | "bool", _) => false,
             (_, VType::Objects(have)) => match self
                 .ctx
-                .and_then(|c| c.index.types.id(&ty.to_lowercase()).map(|w| (c, w)))
+                .and_then(|c| c.index.types.id(pddl_ty).map(|w| (c, w)))
             {
                 Some((c, want)) => c.index.types.fits(have, &[want]),
                 None => true, // unknown port type: reported at the declaration
             },
             (_, VType::Name(obj)) => {
                 let Some(c) = self.ctx else { return };
-                let obj_l = obj.to_lowercase();
+                let obj_l = Key::new(obj);
                 let info = c
                     .problem
-                    .and_then(|p| p.objects.get(&obj_l))
-                    .or_else(|| c.index.constants.get(&obj_l));
+                    .and_then(|p| p.objects.get(obj_l.as_str()))
+                    .or_else(|| c.index.constants.get(obj_l.as_str()));
                 match info {
-                    Some(o) => match c.index.types.id(&ty.to_lowercase()) {
+                    Some(o) => match c.index.types.id(pddl_ty) {
                         Some(want) => c.index.types.fits(&o.types, &[want]),
                         None => true,
                     },
@@ -456,7 +597,7 @@ impl Tcx<'_> {
                             })
                             .unwrap_or_default();
                         // The fix rewrites the whole literal, quotes included.
-                        let candidate = closest(&obj_l, known.iter().copied());
+                        let candidate = closest(obj_l.as_str(), known.iter().copied());
                         let mut d = Diagnostic::error(codes::R_UNKNOWN_OBJECT, value.span(), format!("`{obj}` is not among the problem's objects or the domain's constants"));
                         d = match candidate {
                             Some(c) => d.with_hint(format!("did you mean `{c}`?")).with_fix(
@@ -481,14 +622,29 @@ impl Tcx<'_> {
                     codes::R_PORT_TYPE,
                     value.span(),
                     format!(
-                        "port `{}` takes a `{ty}`, but this is {}",
+                        "port `{}` takes a `{}`, but this is {}",
                         port.name.text,
-                        describe(&vt, self.ctx)
+                        port.ty.text,
+                        describe_vtype(&vt, self.ctx)
                     ),
                 )
                 .with_label(port.span, "the port is declared here"),
             );
         }
+    }
+}
+
+fn describe_vtype(vt: &VType, ctx: Option<DomainCtx>) -> String {
+    match vt {
+        VType::Objects(t) => match ctx {
+            Some(c) => format!("an object of type `{}`", c.index.types.display(t)),
+            None => "an object".to_owned(),
+        },
+        VType::Name(_) | VType::Str => "a string".to_owned(),
+        VType::Int => "an int".to_owned(),
+        VType::Float => "a float".to_owned(),
+        VType::Bool => "a bool".to_owned(),
+        VType::Unknown => "a value".to_owned(),
     }
 }
 
@@ -521,41 +677,17 @@ fn rule_vars(
     vars
 }
 
-/// The domain actions a rule pattern can match, with their captures.
+/// The domain actions a rule pattern's name matches, with their captures
+/// (in domain order).
 pub fn matched_actions<'d>(
     pattern: &Pattern,
     domain: &'d Domain,
-) -> Vec<(&'d btc_pddl::ast::Action, Vec<(String, String)>)> {
-    domain
-        .actions
-        .iter()
-        .filter_map(|a| match_name(&pattern.name, &a.name.name).map(|c| (a, c)))
-        .collect()
-}
-
-/// The domain actions a rule can match: by name, and by its `capture in
-/// table` guards (the other guards depend on the step's objects).
-pub fn rule_actions<'d>(
-    r: &Rule,
-    decls: &Decls,
-    domain: &'d Domain,
-) -> Vec<(&'d btc_pddl::ast::Action, Vec<(String, String)>)> {
-    matched_actions(&r.pattern, domain)
+    actions: &ActionIndex,
+) -> Vec<(&'d btc_pddl::ast::Action, Captures)> {
+    actions
+        .matches(&pattern.name, domain)
         .into_iter()
-        .filter(|(_, caps)| {
-            r.guards.iter().all(|g| match g {
-                Guard::InTable { key, table, .. } => match (
-                    caps.iter().find(|(n, _)| *n == key.text),
-                    decls.tables.get(&table.text),
-                ) {
-                    (Some((_, v)), Some(t)) => {
-                        t.entries.iter().any(|e| e.key.text.eq_ignore_ascii_case(v))
-                    }
-                    _ => true,
-                },
-                _ => true,
-            })
-        })
+        .map(|(i, c)| (&domain.actions[i], c))
         .collect()
 }
 
@@ -586,6 +718,7 @@ pub fn check_item(
                 ctx,
                 vars: port_vars(&t.ports, ctx),
                 captures: Vec::new(),
+                basic: basic_ports(&t.ports),
                 in_plan: false,
                 diags: Vec::new(),
             };
@@ -602,6 +735,7 @@ pub fn check_item(
                 ctx,
                 vars: Vec::new(),
                 captures: Vec::new(),
+                basic: Vec::new(),
                 in_plan: true,
                 diags: Vec::new(),
             };
@@ -625,7 +759,7 @@ pub fn check_item(
             let mut diags = Vec::new();
             let mut seen = BTreeSet::new();
             for e in &t.entries {
-                if !seen.insert(e.key.text.to_lowercase()) {
+                if !seen.insert(&e.key.key) {
                     diags.push(Diagnostic::error(
                         codes::R_DUPLICATE,
                         e.key.span,
@@ -657,9 +791,26 @@ fn port_vars(ports: &[PortDecl], ctx: Option<DomainCtx>) -> Vec<(String, Option<
         .iter()
         .map(|p| {
             let ty = ctx
-                .and_then(|c| c.index.types.id(&p.ty.text.to_lowercase()))
+                .and_then(|c| c.index.types.id(p.ty.key.as_str()))
                 .map(|t| vec![t]);
-            (p.name.text.to_lowercase(), ty)
+            (p.name.key.clone().into_string(), ty)
+        })
+        .collect()
+}
+
+/// Tree ports of basic types, as the variables the tree's body uses.
+fn basic_ports(ports: &[PortDecl]) -> Vec<(String, VType)> {
+    ports
+        .iter()
+        .filter_map(|p| {
+            let t = match p.ty.key.as_str() {
+                "int" => VType::Int,
+                "float" => VType::Float,
+                "bool" => VType::Bool,
+                "string" => VType::Str,
+                _ => return None,
+            };
+            Some((p.name.key.clone().into_string(), t))
         })
         .collect()
 }
@@ -680,7 +831,7 @@ fn port_type_diags(ports: &[PortDecl], ctx: Option<DomainCtx>) -> Vec<Diagnostic
             continue;
         }
         if let Some(c) = ctx {
-            if c.index.types.id(&ty.to_lowercase()).is_none() {
+            if c.index.types.id(p.ty.key.as_str()).is_none() {
                 let candidates: Vec<&str> = c
                     .index
                     .types
@@ -720,75 +871,8 @@ fn check_rule(r: &Rule, decls: &Decls, ctx: Option<DomainCtx>) -> Vec<Diagnostic
             diags.push(d);
         }
     };
-    // Guards refer to the pattern's variables and captures.
-    for g in &r.guards {
-        let vars: Vec<&Ident> = match g {
-            Guard::Ne { left, right, .. } | Guard::Eq { left, right, .. } => vec![left, right],
-            Guard::IsType { var, .. } => vec![var],
-            Guard::InTable { .. } => vec![],
-        };
-        for v in vars {
-            if !r.pattern.params.iter().any(|p| p.var.text == v.text) {
-                push(
-                    Diagnostic::error(
-                        codes::R_UNBOUND,
-                        v.span,
-                        format!("`?{}` is not a parameter of this rule's pattern", v.text),
-                    ),
-                    &mut diags,
-                );
-            }
-        }
-        match g {
-            Guard::InTable { key, table, .. } => {
-                if !r
-                    .pattern
-                    .name
-                    .iter()
-                    .any(|p| matches!(p, NamePart::Capture { name } if name.text == key.text))
-                {
-                    push(
-                        Diagnostic::error(
-                            codes::R_UNBOUND,
-                            key.span,
-                            format!("`{}` is not a capture of this rule's pattern", key.text),
-                        ),
-                        &mut diags,
-                    );
-                }
-                if !decls.tables.contains_key(&table.text) {
-                    push(
-                        Diagnostic::error(
-                            codes::R_UNKNOWN_TABLE,
-                            table.span,
-                            format!("no table is called `{}`", table.text),
-                        ),
-                        &mut diags,
-                    );
-                }
-            }
-            Guard::IsType { ty, .. } => {
-                if let Some(c) = ctx {
-                    if c.index.types.id(&ty.text.to_lowercase()).is_none() {
-                        let d = Diagnostic::error(
-                            codes::R_UNKNOWN_TYPE,
-                            ty.span,
-                            format!("`{}` is not a type of the domain", ty.text),
-                        );
-                        push(
-                            match closest(&ty.text.to_lowercase(), c.index.types.names()) {
-                                Some(t) => d.suggest(Some(t.to_owned()), String::new),
-                                None => d,
-                            },
-                            &mut diags,
-                        );
-                    }
-                }
-            }
-            _ => {}
-        }
-    }
-    let captures_of = |matched: &[(&btc_pddl::ast::Action, Vec<(String, String)>)]| -> Vec<(String, Vec<String>)> {
+    check_guards(r, decls, ctx, &mut |d| push(d, &mut diags));
+    let captures_of = |matched: &[&Captures]| -> Vec<(String, Vec<String>)> {
         r.pattern
             .name
             .iter()
@@ -797,7 +881,10 @@ fn check_rule(r: &Rule, decls: &Decls, ctx: Option<DomainCtx>) -> Vec<Diagnostic
                 NamePart::Lit { .. } => None,
             })
             .map(|c| {
-                let vals: BTreeSet<String> = matched.iter().flat_map(|(_, caps)| caps.iter().filter(|(n, _)| *n == c).map(|(_, v)| v.clone())).collect();
+                let vals: BTreeSet<String> = matched
+                    .iter()
+                    .flat_map(|caps| caps.iter().filter(|(n, _)| *n == c).map(|(_, v)| v.clone()))
+                    .collect();
                 (c, vals.into_iter().collect())
             })
             .collect()
@@ -809,6 +896,7 @@ fn check_rule(r: &Rule, decls: &Decls, ctx: Option<DomainCtx>) -> Vec<Diagnostic
             ctx: None,
             vars: rule_vars(r, None),
             captures: captures_of(&[]),
+            basic: Vec::new(),
             in_plan: false,
             diags: Vec::new(),
         };
@@ -820,11 +908,19 @@ fn check_rule(r: &Rule, decls: &Decls, ctx: Option<DomainCtx>) -> Vec<Diagnostic
         diags.extend(tcx.diags);
         return diags;
     };
-    let matched = rule_actions(r, decls, c.domain);
-    if matched.is_empty() {
+    if r.pattern.name.is_empty() {
+        return diags; // a pattern that did not parse: reported
+    }
+    let reach = reach(r, decls, c);
+    let through_tables: Vec<_> = reach
+        .named
+        .iter()
+        .filter(|(_, _, _, v)| *v != Verdict::NotInTable)
+        .collect();
+    if through_tables.is_empty() {
         let written = r.pattern.name_text();
         let candidate = closest(
-            &written.to_lowercase(),
+            r.pattern.name_key().as_str(),
             c.domain.actions.iter().map(|a| a.name.as_str()),
         )
         .map(str::to_owned);
@@ -842,9 +938,14 @@ fn check_rule(r: &Rule, decls: &Decls, ctx: Option<DomainCtx>) -> Vec<Diagnostic
         );
         return diags;
     }
-    let captures = captures_of(&matched);
-    for (action, _) in &matched {
-        if bind_params(&r.pattern, action.params.len()).is_none() {
+    let captures = captures_of(
+        &through_tables
+            .iter()
+            .map(|(_, _, caps, _)| caps)
+            .collect::<Vec<_>>(),
+    );
+    for (action, _, _, verdict) in &through_tables {
+        if *verdict == Verdict::Arity {
             let required = r.pattern.params.iter().filter(|p| !p.optional).count();
             let total = r.pattern.params.len();
             let takes = if required == total {
@@ -875,27 +976,74 @@ fn check_rule(r: &Rule, decls: &Decls, ctx: Option<DomainCtx>) -> Vec<Diagnostic
                 )),
                 &mut diags,
             );
-            continue;
         }
+    }
+    if let Some(never) = reach.never() {
+        push(never_diagnostic(r, never, &through_tables), &mut diags);
+    }
+    // The template is checked once per action a step can come from (its
+    // variables are typed by that action's parameters); a rule that can
+    // match nothing is still checked, with the actions it names.
+    let can: Vec<&&(&btc_pddl::ast::Action, usize, Captures, Verdict)> = through_tables
+        .iter()
+        .filter(|(_, _, _, v)| *v == Verdict::Can)
+        .collect();
+    let typed: Vec<&btc_pddl::ast::Action> = if can.is_empty() {
+        through_tables
+            .iter()
+            .filter(|(_, _, _, v)| matches!(v, Verdict::Never(_)))
+            .map(|(a, _, _, _)| *a)
+            .collect()
+    } else {
+        can.iter().map(|(a, _, _, _)| *a).collect()
+    };
+    for action in typed {
         let vars = rule_vars(r, Some((action, &c)));
         let mut tcx = Tcx {
             decls,
             ctx: Some(c),
             vars: vars.clone(),
             captures: captures.clone(),
+            basic: Vec::new(),
             in_plan: false,
             diags: Vec::new(),
         };
-        if let RuleBody::Template { body, effect } = &r.body {
-            for t in body {
-                tcx.template(t);
+        match &r.body {
+            RuleBody::Template { body, effect } => {
+                for t in body {
+                    tcx.template(t);
+                }
+                if let Some(e) = effect {
+                    let scope = scope_of(&vars);
+                    tcx.diags
+                        .extend(check_effect_in(c.domain, c.index, c.problem, e, &scope));
+                    if let Some(d) = compare_effect(r, action, e) {
+                        tcx.diags.push(d);
+                    }
+                }
             }
-            if let Some(e) = effect {
-                let scope = scope_of(&vars);
-                tcx.diags
-                    .extend(check_effect_in(c.domain, c.index, c.problem, e, &scope));
-                if let Some(d) = compare_effect(r, action, e) {
-                    tcx.diags.push(d);
+            // A rule no step can match skips nothing (R040-R043 say so).
+            RuleBody::Skip { .. } if can.is_empty() => {}
+            RuleBody::Skip { span } => {
+                let changed = super::skip::changes(r, action);
+                if !changed.is_empty() {
+                    tcx.diags.push(
+                        Diagnostic::warning(
+                            codes::R_SKIP_CHANGES,
+                            *span,
+                            format!(
+                                "`=> skip` drops steps of `{}`, which change the world: {}",
+                                action.name.name,
+                                changed
+                                    .iter()
+                                    .map(|l| format!("`{l}`"))
+                                    .collect::<Vec<_>>()
+                                    .join(", ")
+                            ),
+                        )
+                        .with_label(action.name.span, "the PDDL action")
+                        .with_hint("skip only steps that change nothing, such as a move to where the robot is (`(move ?r ?x ?x)`); give the rule a template to run the step"),
+                    );
                 }
             }
         }
@@ -904,6 +1052,174 @@ fn check_rule(r: &Rule, decls: &Decls, ctx: Option<DomainCtx>) -> Vec<Diagnostic
         }
     }
     diags
+}
+
+/// Guards refer to the pattern's variables and captures, to the domain's
+/// types, to declared tables, and to objects of the domain or problem.
+fn check_guards(r: &Rule, decls: &Decls, ctx: Option<DomainCtx>, push: &mut dyn FnMut(Diagnostic)) {
+    for g in &r.guards {
+        let vars: Vec<&Ident> = match g {
+            Guard::Ne { left, right, .. } | Guard::Eq { left, right, .. } => {
+                [left, right].into_iter().filter_map(Operand::var).collect()
+            }
+            Guard::IsType { var, .. } => vec![var],
+            Guard::InTable { .. } => vec![],
+        };
+        for v in vars {
+            if !r.pattern.params.iter().any(|p| p.var.text == v.text) {
+                push(Diagnostic::error(
+                    codes::R_UNBOUND,
+                    v.span,
+                    format!("`?{}` is not a parameter of this rule's pattern", v.text),
+                ));
+            }
+        }
+        match g {
+            Guard::InTable { key, table, .. } => {
+                if !r
+                    .pattern
+                    .name
+                    .iter()
+                    .any(|p| matches!(p, NamePart::Capture { name } if name.text == key.text))
+                {
+                    push(Diagnostic::error(
+                        codes::R_UNBOUND,
+                        key.span,
+                        format!("`{}` is not a capture of this rule's pattern", key.text),
+                    ));
+                }
+                if !decls.tables.contains_key(&table.text) {
+                    push(Diagnostic::error(
+                        codes::R_UNKNOWN_TABLE,
+                        table.span,
+                        format!("no table is called `{}`", table.text),
+                    ));
+                }
+            }
+            Guard::IsType { ty, .. } => {
+                if let Some(c) = ctx {
+                    if c.index.types.id(ty.key.as_str()).is_none() {
+                        let d = Diagnostic::error(
+                            codes::R_UNKNOWN_TYPE,
+                            ty.span,
+                            format!("`{}` is not a type of the domain", ty.text),
+                        );
+                        push(match closest(ty.key.as_str(), c.index.types.names()) {
+                            Some(t) => d.suggest(Some(t.to_owned()), String::new),
+                            None => d,
+                        });
+                    }
+                }
+            }
+            Guard::Ne { left, right, .. } | Guard::Eq { left, right, .. } => {
+                let Some(c) = ctx else { continue };
+                for o in [left, right] {
+                    if let Operand::Object { name } = o {
+                        if let Some(d) = unknown_object(name, c) {
+                            push(d);
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// R020 for an object name that neither the domain's constants nor the
+/// problem (when there is one) has.
+fn unknown_object(name: &Ident, c: DomainCtx) -> Option<Diagnostic> {
+    let k = name.key.as_str();
+    if c.index.constants.contains_key(k) {
+        return None;
+    }
+    let p = c.problem?; // without a problem, objects are unknown here
+    if p.objects.contains_key(k) {
+        return None;
+    }
+    let known = p
+        .object_names
+        .iter()
+        .chain(&c.index.constant_names)
+        .map(String::as_str);
+    let candidate = closest(k, known);
+    let d = Diagnostic::error(
+        codes::R_UNKNOWN_OBJECT,
+        name.span,
+        format!(
+            "`{}` is not among the problem's objects or the domain's constants",
+            name.text
+        ),
+    );
+    Some(match candidate {
+        Some(cand) => d.with_hint(format!("did you mean `{cand}`?")).with_fix(
+            format!("change to `{cand}`"),
+            name.span,
+            format!("{cand:?}"),
+        ),
+        None => d.with_hint("it names no object of the problem and no constant of the domain"),
+    })
+}
+
+/// The warning for a rule that no step can match, from the reason found
+/// for the first action it names.
+fn never_diagnostic(
+    r: &Rule,
+    never: &Never,
+    named: &[&(&btc_pddl::ast::Action, usize, Captures, Verdict)],
+) -> Diagnostic {
+    let action = named
+        .iter()
+        .find(|(_, _, _, v)| matches!(v, Verdict::Never(n) if n == never))
+        .map(|(a, _, _, _)| a.name.name.as_str())
+        .unwrap_or_default();
+    let others = named.len().saturating_sub(1);
+    let also = if others == 0 {
+        String::new()
+    } else {
+        format!(
+            " (and no step of the {others} other action{} its pattern names can match)",
+            if others == 1 { "" } else { "s" }
+        )
+    };
+    let hint = "a rule no step can match runs nothing; fix or remove the guard, or remove the rule";
+    match never {
+        Never::SameObject { guard } => Diagnostic::warning(
+            codes::R_CONTRADICTION,
+            *guard,
+            format!("this rule never matches: both sides of this `!=` are always the same object{also}"),
+        )
+        .with_hint(hint),
+        Never::TwoObjects { first, second } => Diagnostic::warning(
+            codes::R_CONTRADICTION,
+            *second,
+            format!("this rule never matches: one parameter would have to be two different objects{also}"),
+        )
+        .with_label(*first, "the other object")
+        .with_hint(hint),
+        Never::TypeGuard { guard, var, ty, has } => Diagnostic::warning(
+            codes::R_GUARD_TYPE,
+            *guard,
+            format!("this rule never matches: `?{var}` is a `{has}` in `{action}`, and no `{has}` is a `{ty}`{also}"),
+        )
+        .with_hint(hint),
+        Never::Disjoint { var, first, second } => Diagnostic::warning(
+            codes::R_DISJOINT,
+            second.0,
+            format!("this rule never matches: `?{var}` would be one object that is both a `{}` and a `{}` in `{action}`, and the domain's types share none{also}", first.1, second.1),
+        )
+        .with_label(first.0, format!("a `{}` here", first.1))
+        .with_hint(if r.guards.iter().any(|g| matches!(g, Guard::Eq { .. })) {
+            hint
+        } else {
+            "a repeated variable asks for the same object twice; use two variables"
+        }),
+        Never::ObjectType { object, name, has, want } => Diagnostic::warning(
+            codes::R_GUARD_OBJECT,
+            *object,
+            format!("this rule never matches: `{name}` is a `{has}`, and the parameter it is compared with takes a `{want}` in `{action}`{also}"),
+        )
+        .with_hint(hint),
+    }
 }
 
 /// Literals of a plain effect (`and` of atoms and `not` atoms), with
@@ -1002,319 +1318,23 @@ fn show_literal((positive, pred, args): &(bool, String, Vec<String>), r: &Rule) 
     }
 }
 
-/// The PDDL action's effect with its parameters renamed to the rule's variables.
+/// The PDDL action's effect with its parameters renamed to the rule's
+/// variables (by the fold: all at once, so swaps work, and quantified
+/// variables are renamed out of the way).
 pub fn rewrite_effect(effects: &[&Effect], action: &btc_pddl::ast::Action, r: &Rule) -> String {
-    let text = match effects {
-        [one] => one.to_string(),
-        many => format!(
-            "(and {})",
-            many.iter()
-                .map(|e| e.to_string())
-                .collect::<Vec<_>>()
-                .join(" ")
-        ),
+    use btc_pddl::logic::{self, Renaming, Terms};
+    let parts: Vec<logic::Effect> = effects.iter().map(|e| logic::Effect::from_ast(e)).collect();
+    let effect = match <[logic::Effect; 1]>::try_from(parts) {
+        Ok([one]) => one,
+        Err(many) => logic::Effect::And(many),
     };
-    // Rename through placeholders so `?a`->`?b`, `?b`->`?a` swaps work.
-    let mut out = text;
-    let mut renames = Vec::new();
-    for (i, p) in action.params.iter().enumerate() {
-        if let Some(rp) = r.pattern.params.get(i) {
-            renames.push((
-                format!("?{}", p.name.name),
-                format!("\u{0}{i}\u{0}"),
-                format!("?{}", rp.var.text),
-            ));
-        }
-    }
-    for (from, mid, _) in &renames {
-        out = replace_var(&out, from, mid);
-    }
-    for (_, mid, to) in &renames {
-        out = out.replace(mid.as_str(), to);
-    }
-    out
-}
-
-fn replace_var(text: &str, var: &str, with: &str) -> String {
-    let mut out = String::new();
-    let mut rest = text;
-    while let Some(i) = rest.find(var) {
-        let after = rest[i + var.len()..].chars().next();
-        let whole = !after.is_some_and(|c| c.is_alphanumeric() || c == '_' || c == '-');
-        out.push_str(&rest[..i]);
-        out.push_str(if whole { with } else { var });
-        rest = &rest[i + var.len()..];
-    }
-    out.push_str(rest);
-    out
-}
-
-/// File-level checks; spans absolute. `items` are this file's items.
-pub fn check_file(
-    items: &[ItemNode],
-    decls: &Decls,
-    ctx: Option<DomainCtx>,
-    file: FileId,
-) -> Vec<Diagnostic> {
-    let abs = |s: Span, off: u32| Span {
-        start: s.start + off,
-        end: s.end + off,
-        file,
-    };
-    let mut diags = Vec::new();
-    // `domain` and `plan` items.
-    let domains: Vec<&ItemNode> = items
-        .iter()
-        .filter(|i| matches!(i.item, Item::Domain { .. }))
-        .collect();
-    if domains.is_empty() {
-        diags.push(
-            Diagnostic::error(
-                codes::R_NO_DOMAIN,
-                Span::new(file, 0, 0),
-                "this rules file does not say which PDDL domain it is for",
-            )
-            .with_hint("add `domain \"domain.pddl\"` (a path relative to this file)"),
-        );
-    }
-    for extra in domains.iter().skip(1) {
-        diags.push(Diagnostic::error(
-            codes::R_DUPLICATE,
-            abs(extra.item.span(), extra.offset),
-            "a rules file names one domain; this is a second `domain`",
-        ));
-    }
-    for extra in items
-        .iter()
-        .filter(|i| matches!(i.item, Item::Plan { .. }))
-        .skip(1)
-    {
-        diags.push(Diagnostic::error(
-            codes::R_PLAN_BLOCK,
-            abs(extra.item.span(), extra.offset),
-            "a rules file has one `plan` block; this is a second one",
-        ));
-    }
-    // Duplicate declarations in this file.
-    let mut seen: BTreeMap<String, Span> = BTreeMap::new();
-    for i in items {
-        let name = match &i.item {
-            Item::Node(n) => &n.name,
-            Item::Tree(t) => &t.name,
-            Item::Table(t) => &t.name,
-            _ => continue,
-        };
-        let span = abs(name.span, i.offset);
-        if let Some(first) = seen.get(&name.text) {
-            diags.push(
-                Diagnostic::error(
-                    codes::R_DUPLICATE,
-                    span,
-                    format!("`{}` is declared twice", name.text),
-                )
-                .with_label(*first, "first declared here")
-                .with_hint("nodes, trees and tables share one namespace; rename one of them"),
-            );
-        } else {
-            seen.insert(name.text.clone(), span);
-        }
-    }
-    let rules: Vec<(&Rule, u32)> = items
-        .iter()
-        .filter_map(|i| match &i.item {
-            Item::Rule(r) => Some((r, i.offset)),
-            _ => None,
-        })
-        .collect();
-    // Coverage and shadowing need the domain.
-    if let Some(c) = ctx {
-        if !rules.is_empty() {
-            // A misspelled rule is reported (R002) with the action it likely
-            // meant; that action is not reported again as uncovered.
-            let action_names: Vec<&str> =
-                c.domain.actions.iter().map(|a| a.name.as_str()).collect();
-            let meant: BTreeSet<&str> = rules
-                .iter()
-                .filter(|(r, _)| matched_actions(&r.pattern, c.domain).is_empty())
-                .filter_map(|(r, _)| {
-                    closest(
-                        &r.pattern.name_text().to_lowercase(),
-                        action_names.iter().copied(),
-                    )
-                })
-                .collect();
-            for a in c
-                .domain
-                .actions
-                .iter()
-                .filter(|a| !meant.contains(a.name.as_str()))
-            {
-                if !rules
-                    .iter()
-                    .any(|(r, _)| match_name(&r.pattern.name, &a.name.name).is_some())
-                {
-                    let params: Vec<String> = a
-                        .params
-                        .iter()
-                        .map(|p| format!("?{}", p.name.name))
-                        .collect();
-                    diags.push(
-                        Diagnostic::warning(
-                            codes::R_UNCOVERED,
-                            a.name.span,
-                            format!("no rule covers the action `{}`", a.name.name),
-                        )
-                        .with_hint(format!(
-                            "add `rule ({} {}) {{ ... }}`, or `=> skip` to drop its steps",
-                            a.name.name,
-                            params.join(" ")
-                        )),
-                    );
-                }
-            }
-        }
-        // Only a rule without guards or repeated variables can shadow.
-        let shadowers: Vec<usize> = (0..rules.len())
-            .filter(|&i| can_shadow(rules[i].0))
-            .collect();
-        for (j, (later, loff)) in rules.iter().enumerate() {
-            if let Some((earlier, eoff)) = shadowers
-                .iter()
-                .take_while(|&&i| i < j)
-                .map(|&i| &rules[i])
-                .find(|(e, _)| shadows(e, later, c.domain))
-            {
-                diags.push(
-                    Diagnostic::warning(codes::R_SHADOWED, abs(later.pattern.span, *loff), "this rule never applies: an earlier rule matches every step it matches")
-                        .with_label(abs(earlier.pattern.span, *eoff), "the earlier rule")
-                        .with_hint("the first rule that matches a step wins; move this rule up, or add a guard to the earlier one"),
-                );
-            }
-        }
-    }
-    // Declarations of this file that nothing refers to (unknowable when an
-    // item did not parse).
-    let used = references(items);
-    let broken = items.iter().any(|i| has_error_node(&i.item));
-    for i in items.iter().filter(|_| !broken) {
-        let (kind, name) = match &i.item {
-            Item::Node(n) => ("node", &n.name),
-            Item::Tree(t) => ("tree", &t.name),
-            Item::Table(t) => ("table", &t.name),
-            _ => continue,
-        };
-        if !used.contains(&name.text) {
-            diags.push(
-                Diagnostic::warning(
-                    codes::R_UNUSED,
-                    abs(name.span, i.offset),
-                    format!("{kind} `{}` is declared but never used", name.text),
-                )
-                .with_hint("remove it, or use it in a rule"),
-            );
-        }
-    }
-    let _ = decls;
-    diags
-}
-
-/// Whether `earlier` matches every step `later` matches: same or wider name
-/// set over the domain's actions, no guards, no repeated variables, and
-/// every argument count `later` accepts.
-/// Whether a rule matches every step its pattern names: no guards and no
-/// repeated variables.
-fn can_shadow(r: &Rule) -> bool {
-    let mut vars = BTreeSet::new();
-    r.guards.is_empty() && r.pattern.params.iter().all(|p| vars.insert(&p.var.text))
-}
-
-fn shadows(earlier: &Rule, later: &Rule, domain: &Domain) -> bool {
-    if !earlier.guards.is_empty() {
-        return false;
-    }
-    let mut vars = BTreeSet::new();
-    if !earlier
-        .pattern
+    let pairs: Vec<(logic::Name, logic::Name)> = action
         .params
         .iter()
-        .all(|p| vars.insert(&p.var.text))
-    {
-        return false;
-    }
-    let later_actions = matched_actions(&later.pattern, domain);
-    if later_actions.is_empty() {
-        return false;
-    }
-    later_actions.iter().all(|(a, _)| {
-        match_name(&earlier.pattern.name, &a.name.name).is_some()
-            && (0..=later.pattern.params.len())
-                .filter(|&n| bind_params(&later.pattern, n).is_some())
-                .all(|n| bind_params(&earlier.pattern, n).is_some())
-    })
-}
-
-/// Whether an item, or a template inside it, did not parse.
-fn has_error_node(item: &Item) -> bool {
-    fn t(x: &Template) -> bool {
-        match x {
-            Template::Error { .. } => true,
-            Template::Control { children, .. } => children.iter().any(t),
-            Template::Decorator { child, .. } => t(child),
-            _ => false,
-        }
-    }
-    match item {
-        Item::Error { .. } => true,
-        Item::Rule(Rule {
-            body: RuleBody::Template { body, .. },
-            ..
-        }) => body.iter().any(t),
-        Item::Tree(tr) => tr.body.iter().any(t),
-        Item::Plan { body, .. } => body.iter().any(t),
-        _ => false,
-    }
-}
-
-/// Names of nodes, trees and tables that templates, guards and lookups use.
-pub fn references(items: &[ItemNode]) -> BTreeSet<String> {
-    fn value(v: &Value, out: &mut BTreeSet<String>) {
-        if let Value::Lookup { table, key, .. } = v {
-            out.insert(table.text.clone());
-            value(key, out);
-        }
-    }
-    fn template(t: &Template, out: &mut BTreeSet<String>) {
-        match t {
-            Template::Control { children, .. } => children.iter().for_each(|c| template(c, out)),
-            Template::Decorator { child, .. } => template(child, out),
-            Template::Call { name, args, .. } => {
-                out.insert(name.text.clone());
-                for a in args {
-                    value(&a.value, out);
-                }
-            }
-            _ => {}
-        }
-    }
-    let mut out = BTreeSet::new();
-    for i in items {
-        match &i.item {
-            Item::Rule(r) => {
-                for g in &r.guards {
-                    if let Guard::InTable { table, .. } = g {
-                        out.insert(table.text.clone());
-                    }
-                }
-                if let RuleBody::Template { body, .. } = &r.body {
-                    body.iter().for_each(|t| template(t, &mut out));
-                }
-            }
-            Item::Tree(t) => t.body.iter().for_each(|b| template(b, &mut out)),
-            Item::Plan { body, .. } => body.iter().for_each(|b| template(b, &mut out)),
-            _ => {}
-        }
-    }
-    out
+        .zip(&r.pattern.params)
+        .map(|(p, rp)| (logic::name(&p.name.name), logic::name(&rp.var.text)))
+        .collect();
+    effect.rename(&Renaming { pairs: &pairs }).to_string()
 }
 
 /// The formula a condition node is defined by, if any (for the runtime).

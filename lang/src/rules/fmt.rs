@@ -251,11 +251,12 @@ impl Formatter<'_> {
             }
             Template::Decorator {
                 decorator,
+                args,
                 name,
                 child,
                 ..
             } => {
-                let mut p = format!("{prefix}{}", decorator_head(*decorator));
+                let mut p = format!("{prefix}{}", decorator_head(*decorator, args));
                 if let Some(n) = name {
                     p.push(' ');
                     p.push_str(&string(n));
@@ -277,13 +278,19 @@ fn control_head(c: ControlKind) -> String {
     }
 }
 
-fn decorator_head(d: DecoratorKind) -> String {
-    match d {
-        DecoratorKind::Retry { times } => format!("retry({times})"),
-        DecoratorKind::Repeat { times } => format!("repeat({times})"),
-        DecoratorKind::Timeout { ms } => format!("timeout({ms})"),
-        other => other.keyword().to_owned(),
+/// `retry(3)`, `timeout(msec: ?t)`: arguments as written.
+fn decorator_head(d: DecoratorName, args: &[DecoratorArg]) -> String {
+    if args.is_empty() {
+        return d.keyword().to_owned();
     }
+    let a: Vec<String> = args
+        .iter()
+        .map(|a| match &a.param {
+            Some(p) => format!("{}: {}", p.text, value(&a.value)),
+            None => value(&a.value),
+        })
+        .collect();
+    format!("{}({})", d.keyword(), a.join(", "))
 }
 
 /// A template that fits on one line: a call or `steps`.
@@ -333,10 +340,22 @@ fn pattern(p: &Pattern) -> String {
     s
 }
 
+fn operand(o: &Operand) -> String {
+    match o {
+        Operand::Var { name } => format!("?{}", name.text),
+        Operand::Object { name } => string(&StrLit {
+            parts: vec![StrPart::Text {
+                text: name.text.clone(),
+            }],
+            span: name.span,
+        }),
+    }
+}
+
 fn guard(g: &Guard) -> String {
     match g {
-        Guard::Ne { left, right, .. } => format!("?{} != ?{}", left.text, right.text),
-        Guard::Eq { left, right, .. } => format!("?{} == ?{}", left.text, right.text),
+        Guard::Ne { left, right, .. } => format!("{} != {}", operand(left), operand(right)),
+        Guard::Eq { left, right, .. } => format!("{} == {}", operand(left), operand(right)),
         Guard::IsType { var, ty, .. } => format!("?{} - {}", var.text, ty.text),
         Guard::InTable { key, table, .. } => format!("{} in {}", key.text, table.text),
     }

@@ -25,6 +25,9 @@ pub enum Tok {
     Effect(Box<btc_pddl::ast::Effect>),
     /// A parenthesised group that did not read as PDDL (reported).
     BadPddl,
+    /// A rule's action-name pattern (`move-{src}-to-curb`), read from the
+    /// touching tokens after `rule (`. Made by the parser's pre-pass.
+    NamePattern(Vec<super::ast::NamePart>),
 }
 
 impl fmt::Display for Tok {
@@ -38,6 +41,7 @@ impl fmt::Display for Tok {
             Tok::Punct(p) => write!(f, "`{p}`"),
             Tok::Error(c) => write!(f, "`{c}`"),
             Tok::Formula(_) | Tok::Effect(_) | Tok::BadPddl => f.write_str("a PDDL formula"),
+            Tok::NamePattern(_) => f.write_str("an action-name pattern"),
         }
     }
 }

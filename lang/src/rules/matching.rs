@@ -1,48 +1,88 @@
 //! Matching plan steps against rule patterns: action names with captures
 //! (case-insensitive), optional parameters, repeated variables, guards.
+//!
+//! Names are compared by key: a pattern's literal parts are folded when the
+//! rule is parsed and PDDL action names are folded by the PDDL lexer, so
+//! matching allocates nothing but the captures it returns.
 
-use super::ast::{Guard, NamePart, Pattern, Rule, TableDecl};
+use super::ast::{Guard, NamePart, Operand, Pattern, Rule, TableDecl};
+use std::cell::Cell;
 
-/// Captured parts of an action name, by capture name, as written in the plan.
+/// Captured parts of an action name, by capture name, as they stand in the
+/// (folded) action name.
 pub type Captures = Vec<(String, String)>;
 
-/// Matches an action name against a pattern's name parts; each capture
-/// takes at least one character.
-pub fn match_name(parts: &[NamePart], action: &str) -> Option<Captures> {
-    let action = action.to_lowercase();
-    let mut caps = Vec::new();
-    go(parts, &action, &mut caps).then_some(caps)
+thread_local! {
+    static COMPARISONS: Cell<u64> = const { Cell::new(0) };
 }
 
-fn go(parts: &[NamePart], rest: &str, caps: &mut Captures) -> bool {
-    let Some((first, more)) = parts.split_first() else {
-        return rest.is_empty();
-    };
-    match first {
-        NamePart::Lit { text, .. } => {
-            let lit = text.to_lowercase();
-            rest.strip_prefix(lit.as_str())
-                .is_some_and(|r| go(more, r, caps))
-        }
-        NamePart::Capture { name } => {
-            // Shortest capture first, so `{a}_{b}` splits at the first `_`.
-            for (i, _) in rest
-                .char_indices()
-                .skip(1)
-                .chain(std::iter::once((rest.len(), ' ')))
-            {
-                if i == 0 {
-                    continue;
+/// How many action names this thread has compared with a pattern so far:
+/// what the shape tests count to show that checking is linear.
+pub fn name_comparisons() -> u64 {
+    COMPARISONS.with(Cell::get)
+}
+
+/// Counts one comparison of a pattern with an action name (for callers
+/// that compare without [`match_name`], such as a lookup by name).
+pub fn count_comparison() {
+    COMPARISONS.with(|c| c.set(c.get() + 1));
+}
+
+/// Matches a PDDL action name (folded, as the PDDL front end gives it)
+/// against a pattern's name parts. Each capture takes at least one
+/// character; when the name splits in more than one way, captures are
+/// filled from left to right and each takes the shortest part that lets
+/// the rest of the pattern match. Linear in parts x name length.
+pub fn match_name(parts: &[NamePart], action: &str) -> Option<Captures> {
+    count_comparison();
+    if let [NamePart::Lit { key, .. }] = parts {
+        return (key.as_str() == action).then(Vec::new);
+    }
+    let n = action.len();
+    let width = n + 1;
+    // fits[i * width + p]: parts[i..] match action[p..]. Filled from the
+    // last part back; a capture fits at p when the rest fits anywhere
+    // after p's first character, so one running "fits later" flag serves.
+    let mut fits = vec![false; (parts.len() + 1) * width];
+    fits[parts.len() * width + n] = true;
+    for (i, part) in parts.iter().enumerate().rev() {
+        let (row, next) = (i * width, (i + 1) * width);
+        match part {
+            NamePart::Lit { key, .. } => {
+                let lit = key.as_str();
+                for p in 0..=n.saturating_sub(lit.len()) {
+                    fits[row + p] = action.as_bytes()[p..].starts_with(lit.as_bytes())
+                        && fits[next + p + lit.len()];
                 }
-                caps.push((name.text.clone(), rest[..i].to_owned()));
-                if go(more, &rest[i..], caps) {
-                    return true;
-                }
-                caps.pop();
             }
-            false
+            NamePart::Capture { .. } => {
+                let mut later = false;
+                for p in (0..n).rev() {
+                    later |= fits[next + p + 1];
+                    fits[row + p] = later && action.is_char_boundary(p);
+                }
+            }
         }
     }
+    if !fits[0] {
+        return None;
+    }
+    let mut caps = Vec::new();
+    let mut p = 0;
+    for (i, part) in parts.iter().enumerate() {
+        match part {
+            NamePart::Lit { key, .. } => p += key.as_str().len(),
+            NamePart::Capture { name } => {
+                let next = (i + 1) * width;
+                let end = (p + 1..=n)
+                    .find(|&q| fits[next + q] && action.is_char_boundary(q))
+                    .expect("the table says the rest fits");
+                caps.push((name.text.clone(), action[p..end].to_owned()));
+                p = end;
+            }
+        }
+    }
+    Some(caps)
 }
 
 /// Which pattern parameter each step argument binds: `None` when the step's
@@ -71,11 +111,11 @@ pub type Bindings = Vec<(String, String)>;
 
 /// What a guard needs to know about objects.
 pub trait ObjectTypes {
-    /// Whether `object` has a type that fits PDDL type `ty`.
+    /// Whether `object` has a type that fits PDDL type `ty` (both folded).
     fn object_is(&self, object: &str, ty: &str) -> bool;
 }
 
-/// Matches a step (action name and arguments, lower-case) against a rule:
+/// Matches a step (action name and arguments, folded) against a rule:
 /// name, argument count, repeated variables, guards.
 pub fn match_step(
     rule: &Rule,
@@ -107,30 +147,31 @@ pub fn match_args(
             None => bindings.push((var.clone(), arg.clone())),
         }
     }
-    let value = |v: &str| {
-        bindings
-            .iter()
-            .find(|(n, _)| n == v)
-            .map(|(_, o)| o.as_str())
-    };
+    fn value<'a>(o: &'a Operand, bindings: &'a Bindings) -> Option<&'a str> {
+        match o {
+            Operand::Var { name } => bindings
+                .iter()
+                .find(|(n, _)| *n == name.text)
+                .map(|(_, o)| o.as_str()),
+            Operand::Object { name } => Some(name.key.as_str()),
+        }
+    }
+    let value = |o| value(o, &bindings);
     for g in &rule.guards {
         let ok = match g {
-            Guard::Ne { left, right, .. } => value(&left.text) != value(&right.text),
-            Guard::Eq { left, right, .. } => {
-                value(&left.text).is_some() && value(&left.text) == value(&right.text)
-            }
-            Guard::IsType { var, ty, .. } => {
-                value(&var.text).is_some_and(|o| types.object_is(o, &ty.text.to_lowercase()))
-            }
+            Guard::Ne { left, right, .. } => value(left) != value(right),
+            Guard::Eq { left, right, .. } => value(left).is_some() && value(left) == value(right),
+            Guard::IsType { var, ty, .. } => bindings
+                .iter()
+                .find(|(n, _)| *n == var.text)
+                .is_some_and(|(_, o)| types.object_is(o, ty.key.as_str())),
             Guard::InTable { key, table, .. } => {
                 let cap = caps
                     .iter()
                     .find(|(n, _)| *n == key.text)
                     .map(|(_, v)| v.as_str());
                 match (cap, tables(&table.text)) {
-                    (Some(c), Some(t)) => {
-                        t.entries.iter().any(|e| e.key.text.eq_ignore_ascii_case(c))
-                    }
+                    (Some(c), Some(t)) => t.entries.iter().any(|e| e.key.key.as_str() == c),
                     _ => false,
                 }
             }
@@ -148,7 +189,9 @@ mod tests {
     use crate::rules::{parse_rules, Item};
 
     fn rule(text: &str) -> Rule {
-        match parse_rules(text, 0).items.remove(0).item {
+        let parsed = parse_rules(text, 0);
+        assert!(parsed.diagnostics.is_empty(), "{:#?}", parsed.diagnostics);
+        match parsed.items.into_iter().next().unwrap().item {
             Item::Rule(r) => r,
             other => panic!("{other:?}"),
         }
@@ -181,7 +224,7 @@ mod tests {
     #[test]
     fn repeated_variables_and_guards() {
         let skip = rule("rule (move ?r ?x ?x) => skip");
-        assert!(m(&skip, "MOVE", &["r1", "a", "a"]).is_some());
+        assert!(m(&skip, "move", &["r1", "a", "a"]).is_some());
         assert!(m(&skip, "move", &["r1", "a", "b"]).is_none());
         let g = rule("rule (move ?r ?a ?b) where ?a != ?b, ?r - robot { X() }");
         assert!(m(&g, "move", &["r1", "a", "b"]).is_some());
@@ -190,10 +233,29 @@ mod tests {
     }
 
     #[test]
+    fn guards_compare_with_objects() {
+        let g = rule("rule (move ?r ?a ?b) where ?r == \"Floor_Robot\", \"bin1\" != ?b { X() }");
+        assert!(m(&g, "move", &["floor_robot", "a", "b"]).is_some());
+        assert!(m(&g, "move", &["ceiling_robot", "a", "b"]).is_none());
+        assert!(m(&g, "move", &["floor_robot", "a", "bin1"]).is_none());
+    }
+
+    #[test]
     fn two_captures_split_at_the_first_literal() {
         let r = rule("rule ({verb}_{op} ?a) { X() }");
         let (caps, _) = m(&r, "pick_op_1", &["a"]).unwrap();
         assert_eq!(caps[0].1, "pick");
         assert_eq!(caps[1].1, "op_1");
+    }
+
+    #[test]
+    fn many_captures_stay_linear() {
+        // Backtracking would try every split of the name for each capture.
+        let r = rule("rule ({a}{b}{c}{d}{e}{f}x ?p) { X() }");
+        let name = "y".repeat(5000);
+        assert!(m(&r, &name, &["p"]).is_none());
+        let (caps, _) = m(&r, &format!("{name}x"), &["p"]).unwrap();
+        assert_eq!(caps[0].1, "y");
+        assert_eq!(caps[5].1.len(), 4995);
     }
 }

@@ -146,7 +146,7 @@ pub fn parse_rules_with(
 /// file's lexer has reported lexical errors already, so these are dropped.
 pub fn parse_item_text(text: &str, file: FileId) -> (Item, Vec<Diagnostic>) {
     let lexed = lex(text, file);
-    parse_item(&lexed.tokens, 0, file)
+    parse_item(&lexed.tokens, text, 0, file)
 }
 
 /// Moves a diagnostic's spans in `file` by `offset` (from item-relative to
@@ -233,8 +233,8 @@ fn read_pddl_group(
                 depth -= 1;
                 PTok::RParen
             }
-            Tok::Ident(n) => PTok::Name(n.to_lowercase()),
-            Tok::Var(v) => PTok::Var(v.to_lowercase()),
+            Tok::Ident(n) => PTok::Name(Key::new(n).into_string()),
+            Tok::Var(v) => PTok::Var(Key::new(v).into_string()),
             Tok::Int(n) => PTok::Number(*n as f64),
             Tok::Float(n) => PTok::Number(*n),
             Tok::Punct("-") => PTok::Dash,
@@ -284,7 +284,138 @@ fn read_pddl_group(
     ((tok, SimpleSpan::from(start..end)), j)
 }
 
-fn parse_item(tokens: &[(Tok, Span)], offset: u32, file: FileId) -> (Item, Vec<Diagnostic>) {
+/// Characters that may stand in the literal parts of an action-name
+/// pattern: those of PDDL names.
+fn is_name_char(c: char) -> bool {
+    c.is_ascii_alphanumeric() || c == '_' || c == '-'
+}
+
+/// Reads the action-name pattern that starts at `tokens[i]` (just after
+/// `rule (`): the run of touching name tokens, hyphens, numbers and
+/// `{capture}`s, split into parts from the item's text. Returns the
+/// replacement token (`None` when no name starts here) and the index after
+/// the run.
+fn read_name_pattern(
+    tokens: &[(Tok, Span)],
+    i: usize,
+    text: &str,
+    offset: u32,
+    file: FileId,
+    diags: &mut Vec<Diagnostic>,
+) -> (Option<(Tok, SimpleSpan)>, usize) {
+    let part_of_name =
+        |t: &Tok| matches!(t, Tok::Ident(_) | Tok::Int(_) | Tok::Punct("-" | "{" | "}"));
+    if !tokens
+        .get(i)
+        .is_some_and(|(t, _)| matches!(t, Tok::Ident(_) | Tok::Punct("{")))
+    {
+        return (None, i);
+    }
+    let mut j = i + 1;
+    while j < tokens.len() && part_of_name(&tokens[j].0) && tokens[j].1.start == tokens[j - 1].1.end
+    {
+        j += 1;
+    }
+    // Spans relative to the item, as everything the parser makes.
+    let (start, end) = (
+        (tokens[i].1.start - offset) as usize,
+        (tokens[j - 1].1.end - offset) as usize,
+    );
+    let span = |a: usize, b: usize| Span::new(file, a, b);
+    if let Some((t, s)) = tokens.get(j) {
+        if matches!(t, Tok::Ident(_) | Tok::Punct("{")) {
+            let r = rel(*s, offset);
+            diags.push(Diagnostic::error(
+                codes::R_SYNTAX,
+                span(r.start, r.end),
+                "the parts of an action-name pattern must touch: write `move-{src}-to-curb`, without spaces",
+            ));
+        }
+    }
+    let raw = &text[start..end];
+    let mut parts = Vec::new();
+    let mut lit_start = None::<usize>;
+    let mut k = 0;
+    let flush = |parts: &mut Vec<NamePart>, from: Option<usize>, to: usize| {
+        if let Some(a) = from {
+            let t = &raw[a..to];
+            parts.push(NamePart::Lit {
+                text: t.to_owned(),
+                key: Key::new(t),
+                span: span(start + a, start + to),
+            });
+        }
+    };
+    while k < raw.len() {
+        let c = raw[k..].chars().next().expect("in bounds");
+        match c {
+            '{' => {
+                flush(&mut parts, lit_start.take(), k);
+                let Some(close) = raw[k..].find('}').map(|n| k + n) else {
+                    diags.push(
+                        Diagnostic::error(
+                            codes::R_SYNTAX,
+                            span(start + k, end),
+                            "this `{` opens a capture that is never closed",
+                        )
+                        .with_hint("a capture is a name in braces, such as `{op}`"),
+                    );
+                    return (Some((Tok::BadPddl, rel_range(start, end))), j);
+                };
+                let inner = &raw[k + 1..close];
+                let ok = inner.starts_with(|c: char| c.is_ascii_alphabetic() || c == '_')
+                    && inner.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+                if !ok {
+                    diags.push(
+                        Diagnostic::error(
+                            codes::R_SYNTAX,
+                            span(start + k, start + close + 1),
+                            format!("`{{{inner}}}` is not a capture: a capture is a name in braces, such as `{{op}}`"),
+                        ),
+                    );
+                    return (Some((Tok::BadPddl, rel_range(start, end))), j);
+                }
+                parts.push(NamePart::Capture {
+                    name: Ident::new(inner.to_owned(), span(start + k + 1, start + close)),
+                });
+                k = close + 1;
+            }
+            '}' => {
+                diags.push(Diagnostic::error(
+                    codes::R_SYNTAX,
+                    span(start + k, start + k + 1),
+                    "this `}` closes no capture",
+                ));
+                return (Some((Tok::BadPddl, rel_range(start, end))), j);
+            }
+            c if is_name_char(c) => {
+                lit_start.get_or_insert(k);
+                k += c.len_utf8();
+            }
+            c => {
+                diags.push(Diagnostic::error(
+                    codes::R_SYNTAX,
+                    span(start + k, start + k + c.len_utf8()),
+                    format!("`{c}` cannot stand in an action name"),
+                ));
+                return (Some((Tok::BadPddl, rel_range(start, end))), j);
+            }
+        }
+    }
+    flush(&mut parts, lit_start.take(), raw.len());
+    (Some((Tok::NamePattern(parts), rel_range(start, end))), j)
+}
+
+fn rel_range(start: usize, end: usize) -> SimpleSpan {
+    SimpleSpan::from(start..end)
+}
+
+fn parse_item(
+    tokens: &[(Tok, Span)],
+    text: &str,
+    offset: u32,
+    file: FileId,
+) -> (Item, Vec<Diagnostic>) {
     let mut diags = Vec::new();
     let whole = Span::new(
         file,
@@ -294,10 +425,19 @@ fn parse_item(tokens: &[(Tok, Span)], offset: u32, file: FileId) -> (Item, Vec<D
     // Pre-pass: relative spans, PDDL groups read, nesting bounded.
     let mut input: Vec<(Tok, SimpleSpan)> = Vec::with_capacity(tokens.len());
     let is_condition = matches!(tokens.first(), Some((Tok::Ident(k), _)) if k == "condition");
+    let is_rule = matches!(tokens.first(), Some((Tok::Ident(k), _)) if k == "rule");
     let mut nesting = Nesting::default();
     let mut i = 0;
     while i < tokens.len() {
         let (t, span) = &tokens[i];
+        if i == 2 && is_rule && matches!(tokens[1].0, Tok::Punct("(")) {
+            let (tok, next) = read_name_pattern(tokens, i, text, offset, file, &mut diags);
+            if let Some(tok) = tok {
+                input.push(tok);
+                i = next;
+                continue;
+            }
+        }
         let prev = input.last().map(|p| &p.0);
         if matches!(t, Tok::Punct("(")) {
             let effect = matches!(prev, Some(Tok::Ident(k)) if k == "effect");
@@ -380,16 +520,11 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
 ) -> impl Parser<'t, I, Item, Err<'t>> {
     let sp = move |s: SimpleSpan| Span::new(file, s.start, s.end);
     let ident = select! { Tok::Ident(s) => s }
-        .map_with(move |text, e| Ident {
-            text,
-            span: sp(e.span()),
-        })
+        .map_with(move |text, e| Ident::new(text, sp(e.span())))
         .labelled("a name");
+    // Variables are PDDL's, so they are shown (and compared) folded.
     let var = select! { Tok::Var(s) => s }
-        .map_with(move |text: String, e| Ident {
-            text: text.to_lowercase(),
-            span: sp(e.span()),
-        })
+        .map_with(move |text: String, e| Ident::new(Key::new(&text).into_string(), sp(e.span())))
         .labelled("a variable");
     let int = select! { Tok::Int(n) => n }.labelled("a whole number");
     let count = int.try_map(|n, span| {
@@ -522,24 +657,42 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
                 span: sp(e.span()),
             },
         );
-        let arg1 = |k: &'static str| kw(k).ignore_then(count.delimited_by(punct("("), punct(")")));
-        let decorator_kind = choice((
-            arg1("retry").map(|times| DecoratorKind::Retry { times }),
-            arg1("repeat").map(|times| DecoratorKind::Repeat { times }),
-            arg1("timeout").map(|ms| DecoratorKind::Timeout { ms: ms as u64 }),
-            kw("inverter").to(DecoratorKind::Inverter),
-            kw("force_success").to(DecoratorKind::ForceSuccess),
-            kw("force_failure").to(DecoratorKind::ForceFailure),
-        ));
-        let decorator = decorator_kind
-            .then(strlit.or_not())
-            .then(template.clone())
-            .map_with(move |((decorator, name), child), e| Template::Decorator {
-                decorator,
-                name,
-                child: Box::new(child),
+        // Arguments are read for every decorator and checked against its
+        // parameter by the checker, which can say what is wrong.
+        let decorator_arg = ident
+            .then_ignore(punct(":"))
+            .or_not()
+            .then(value.clone())
+            .map_with(move |(param, value), e| DecoratorArg {
+                param,
+                value,
                 span: sp(e.span()),
             });
+        let decorator_name = select! {
+            Tok::Ident(s) if DecoratorName::from_keyword(&s).is_some() => s,
+        }
+        .map(|s| DecoratorName::from_keyword(&s).expect("selected"))
+        .labelled("a decorator");
+        let decorator = decorator_name
+            .then(
+                decorator_arg
+                    .separated_by(punct(","))
+                    .allow_trailing()
+                    .collect::<Vec<_>>()
+                    .delimited_by(punct("("), punct(")"))
+                    .or_not(),
+            )
+            .then(strlit.or_not())
+            .then(template.clone())
+            .map_with(
+                move |(((decorator, args), name), child), e| Template::Decorator {
+                    decorator,
+                    args: args.unwrap_or_default(),
+                    name,
+                    child: Box::new(child),
+                    span: sp(e.span()),
+                },
+            );
         let steps = kw("steps")
             .ignore_then(
                 choice((
@@ -672,15 +825,6 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
             })
         });
 
-    let name_part = choice((
-        ident.map(|i| NamePart::Lit {
-            text: i.text,
-            span: i.span,
-        }),
-        ident
-            .delimited_by(punct("{"), punct("}"))
-            .map(|name| NamePart::Capture { name }),
-    ));
     let param = choice((
         var.map_with(move |var, e| Param {
             var,
@@ -694,36 +838,46 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
                 span: sp(e.span()),
             }),
     ));
-    let pattern = name_part
-        .map_with(|p, e| (p, e.span()))
-        .repeated()
-        .at_least(1)
-        .collect::<Vec<(NamePart, SimpleSpan)>>()
-        .validate(|parts, _, emitter| {
-            for w in parts.windows(2) {
-                if w[0].1.end != w[1].1.start {
-                    emitter.emit(Rich::custom(
-                        w[1].1,
-                        "the parts of an action-name pattern must touch: write `PICK_{op}`, without spaces",
-                    ));
-                }
-            }
-            parts.into_iter().map(|(p, _)| p).collect::<Vec<_>>()
-        })
+    // The name was read by the pre-pass (`read_name_pattern`); a broken
+    // one is reported there and reads as an empty name.
+    let name_pattern = select! {
+        Tok::NamePattern(parts) => parts,
+        Tok::BadPddl => Vec::new(),
+    }
+    .labelled("an action name such as `move` or `pick-{op}`");
+    let pattern = name_pattern
         .then(param.repeated().collect::<Vec<_>>())
         .delimited_by(punct("("), punct(")"))
-        .map_with(move |(name, params), e| Pattern { name, params, span: sp(e.span()) })
+        .map_with(move |(name, params), e| Pattern {
+            name,
+            params,
+            span: sp(e.span()),
+        })
         .labelled("an action pattern such as `(move ?robot ?from ?to)`");
+    // `"floor_robot"`: a plain string names an object or constant.
+    let object = strlit
+        .try_map(|s: StrLit, span| match s.plain() {
+            Some(text) => Ok(Ident::new(text, s.span)),
+            None => Err(Rich::custom(
+                span,
+                "a guard compares with an object's name: a string without `{...}`",
+            )),
+        })
+        .map(|name| Operand::Object { name });
+    let operand = choice((var.map(|name| Operand::Var { name }), object))
+        .labelled("a variable or an object name in quotes");
     let guard = choice((
-        var.then_ignore(punct("!="))
-            .then(var)
+        operand
+            .then_ignore(punct("!="))
+            .then(operand)
             .map_with(move |(left, right), e| Guard::Ne {
                 left,
                 right,
                 span: sp(e.span()),
             }),
-        var.then_ignore(punct("=="))
-            .then(var)
+        operand
+            .then_ignore(punct("=="))
+            .then(operand)
             .map_with(move |(left, right), e| Guard::Eq {
                 left,
                 right,
@@ -844,9 +998,9 @@ fn interpolate(raw: &str, file: FileId, start: usize) -> Result<StrLit, (String,
                     parts.push(StrPart::Text { text: std::mem::take(&mut text) });
                 }
                 parts.push(if is_var {
-                    StrPart::Var { name: Ident { text: name.to_lowercase(), span } }
+                    StrPart::Var { name: Ident::new(Key::new(name).into_string(), span) }
                 } else {
-                    StrPart::Capture { name: Ident { text: name.to_owned(), span } }
+                    StrPart::Capture { name: Ident::new(name.to_owned(), span) }
                 });
                 while chars.peek().is_some_and(|(k, _)| *k <= close) {
                     chars.next();

@@ -30,11 +30,16 @@ pub struct Example {
 }
 
 pub fn example(name: &str) -> Example {
-    let dir = root().join("examples").join(name);
+    compile_dir(&root().join("examples").join(name), name)
+}
+
+/// A folder with `rules.btrules`, `problem.pddl`, a domain and a `plan.*`,
+/// compiled (`name` for messages).
+pub fn compile_dir(dir: &Path, name: &str) -> Example {
     let mut db = Database::new();
     let mut rules = None;
     let mut plan = None;
-    let mut names: Vec<PathBuf> = std::fs::read_dir(&dir)
+    let mut names: Vec<PathBuf> = std::fs::read_dir(dir)
         .unwrap()
         .map(|e| e.unwrap().path())
         .filter(|p| p.is_file())

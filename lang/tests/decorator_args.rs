@@ -1,0 +1,83 @@
+//! Decorator arguments (issue #10.4): they take the values ports take
+//! (numbers, variables, table lookups, captures), by position or by the
+//! parameter's name, and are checked against the decorator's parameter.
+//! `fixtures/decorators/good.btrules` checks clean and its step-dependent
+//! arguments reach the BT.CPP output as ports; `bad.btrules` gets one
+//! diagnostic per mistake, in the user's terms (snapshot).
+
+use btc_emit::{emit, Format, Options};
+use btc_lang::db::{compile, normalize, rules_diagnostics, CompileJob, Database, SourceFile};
+use std::path::{Path, PathBuf};
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+fn load(db: &mut Database, rel: &str) -> SourceFile {
+    let p = repo().join(rel);
+    db.set_file(&normalize(&p), std::fs::read_to_string(&p).unwrap())
+}
+
+/// `line:col [CODE] message` for each diagnostic of a rules fixture.
+fn check(name: &str) -> (Database, SourceFile, Vec<String>) {
+    let mut db = Database::new();
+    load(&mut db, "examples/ariac/domain.pddl");
+    let rel = format!("lang/tests/fixtures/decorators/{name}");
+    let f = load(&mut db, &rel);
+    let text = f.text(&db).clone();
+    let lines = rules_diagnostics(&db, f)
+        .iter()
+        .map(|d| {
+            let before = &text[..(d.span.start as usize).min(text.len())];
+            let line = before.matches('\n').count() + 1;
+            let col = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+            format!("{line}:{col} [{}] {}", d.code, d.message)
+        })
+        .collect();
+    (db, f, lines)
+}
+
+#[test]
+fn decorator_arguments_take_port_values() {
+    let (mut db, f, diags) = check("good.btrules");
+    assert!(diags.is_empty(), "{diags:#?}");
+
+    let problem = load(&mut db, "examples/ariac/problem.pddl");
+    let plan = load(&mut db, "examples/ariac/plan.txt");
+    let job = CompileJob::new(&db, f, plan, Some(problem), None);
+    let ir = compile(&db, job).as_ref().unwrap();
+    let xml = emit(ir, Format::Btcpp, &Options::default());
+    // The move rule's time limit depends on the step: a port of its tree,
+    // which each step's call fills in with the table's number.
+    assert!(xml.contains("<Timeout msec=\"{"), "{xml}");
+    assert!(xml.contains("=\"6000\""), "the move to agv1: {xml}");
+    assert!(xml.contains("=\"1500\""), "the move to bin1: {xml}");
+    // The same number for every step stays a number.
+    assert!(xml.contains("<Timeout msec=\"100\""), "{xml}");
+    // The inlined tree has the step's number in place.
+    let flat = emit(
+        ir,
+        Format::Btcpp,
+        &Options {
+            inline: true,
+            ..Options::default()
+        },
+    );
+    assert!(flat.contains("<Timeout msec=\"6000\""), "{flat}");
+    assert!(!flat.contains("msec=\"{"), "{flat}");
+    // py_trees takes the number when the tree is built: the step's own.
+    let py = emit(ir, Format::Pytrees, &Options::default());
+    assert!(py.contains("Timeout(") && py.contains("duration=6"), "{py}");
+    assert!(py.contains("duration=1.5"), "{py}");
+    assert!(!py.contains("could not inline"), "{py}");
+}
+
+#[test]
+fn wrong_decorator_arguments_say_what_is_wrong() {
+    let (_, _, diags) = check("bad.btrules");
+    for d in &diags {
+        assert!(!d.contains("expected"), "a parse error: {d}");
+        assert!(!d.contains("action timeout"), "a misleading hint: {d}");
+    }
+    insta::assert_snapshot!(diags.join("\n"));
+}

@@ -1,0 +1,160 @@
+//! The landmark-count heuristic of LAMA: the cost of the landmarks a state
+//! has not reached yet, plus those it reached but needs again. Which
+//! landmarks are reached depends on the path to a state, so it is kept per
+//! state as a bitset and carried along transitions: a landmark becomes
+//! reached when it holds and every landmark ordered before it was reached
+//! in the state before. A reached landmark is needed again when it does not
+//! hold and it is a goal, or a landmark ordered after it is not reached.
+
+use crate::heuristic::Costs;
+use crate::landmarks::{Landmark, LandmarkGraph};
+use crate::task::test;
+
+pub struct LmCount<'g> {
+    graph: &'g LandmarkGraph,
+    /// Each landmark's cost in the count.
+    cost: Vec<u64>,
+    words: usize,
+}
+
+fn holds(l: &Landmark, s: &[u64]) -> bool {
+    l.facts.iter().any(|&f| test(s, f))
+}
+
+fn bit(set: &[u64], i: usize) -> bool {
+    set[i >> 6] >> (i & 63) & 1 == 1
+}
+
+impl<'g> LmCount<'g> {
+    pub fn new(graph: &'g LandmarkGraph, costs: Costs) -> LmCount<'g> {
+        LmCount {
+            cost: graph
+                .landmarks
+                .iter()
+                .map(|l| costs.of(l.min_cost))
+                .collect(),
+            words: graph.landmarks.len().div_ceil(64).max(1),
+            graph,
+        }
+    }
+
+    /// The number of landmarks.
+    pub fn len(&self) -> usize {
+        self.cost.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.cost.is_empty()
+    }
+
+    /// Words of a reached set.
+    pub fn words(&self) -> usize {
+        self.words
+    }
+
+    /// The landmarks reached in the initial state `s`: those that hold.
+    pub fn initial(&self, s: &[u64], out: &mut Vec<u64>) {
+        out.clear();
+        out.resize(self.words, 0);
+        for (i, l) in self.graph.landmarks.iter().enumerate() {
+            if holds(l, s) {
+                out[i >> 6] |= 1 << (i & 63);
+            }
+        }
+    }
+
+    /// The landmarks reached in `s` after a transition from a state whose
+    /// reached set is `before`.
+    pub fn progress(&self, before: &[u64], s: &[u64], out: &mut Vec<u64>) {
+        out.clear();
+        out.extend_from_slice(before);
+        for (i, l) in self.graph.landmarks.iter().enumerate() {
+            if !bit(before, i) && holds(l, s) && l.parents.iter().all(|&p| bit(before, p as usize))
+            {
+                out[i >> 6] |= 1 << (i & 63);
+            }
+        }
+    }
+
+    /// The heuristic value of `s` with `reached` landmarks.
+    pub fn value(&self, reached: &[u64], s: &[u64]) -> u64 {
+        let mut h = 0;
+        for (i, l) in self.graph.landmarks.iter().enumerate() {
+            let needed = !bit(reached, i)
+                || (!holds(l, s)
+                    && (l.goal || l.children.iter().any(|&c| !bit(reached, c as usize))));
+            if needed {
+                h += self.cost[i];
+            }
+        }
+        h
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::task::AxiomScratch;
+    use crate::test_util::{fact, task};
+
+    #[test]
+    fn landmarks_are_counted_reached_and_needed_again() {
+        let t = task(
+            include_str!("../../examples/ariac/domain.pddl"),
+            include_str!("../../examples/ariac/problem.pddl"),
+        );
+        let g = LandmarkGraph::generate(&t);
+        let h = LmCount::new(&g, Costs::Unit);
+        let mut reached = Vec::new();
+        h.initial(&t.init, &mut reached);
+        // Five landmarks; the part in the bin holds already.
+        assert_eq!(h.value(&reached, &t.init), 4);
+        let op = |from: &str, to: &str| {
+            let (f, g) = (fact(&t, from), fact(&t, to));
+            t.operators
+                .iter()
+                .find(|o| {
+                    o.pre.iter().any(|l| l.positive && l.fact == f)
+                        && o.effects.iter().any(|e| e.add && e.fact == g)
+                })
+                .unwrap()
+        };
+        let at = |c: &str| format!("(is_reachable floor_robot {c})");
+        let mut ax = AxiomScratch::default();
+        let (mut s, mut next, mut r2) = (t.init.clone(), Vec::new(), Vec::new());
+        for (from, to, h_after) in [
+            (at("curr_position"), at("bin1"), 3),
+            (
+                "(on battery_red bin1)".to_owned(),
+                "(attach battery_red floor_robot)".to_owned(),
+                2,
+            ),
+            // Leaving the bin for the AGV: the bin is no longer needed.
+            (at("bin1"), at("agv1"), 1),
+            (
+                "(attach battery_red floor_robot)".to_owned(),
+                "(on battery_red agv1)".to_owned(),
+                0,
+            ),
+        ] {
+            t.apply(op(&from, &to), &s, &mut next, &mut ax);
+            h.progress(&reached, &next, &mut r2);
+            std::mem::swap(&mut s, &mut next);
+            std::mem::swap(&mut reached, &mut r2);
+            assert_eq!(h.value(&reached, &s), h_after, "after {to}");
+        }
+        // Going to the AGV before the bin reaches the AGV landmark, but
+        // it is needed again once the part is held.
+        let mut s = t.init.clone();
+        h.initial(&s, &mut reached);
+        for (from, to) in [(at("curr_position"), at("agv1")), (at("agv1"), at("bin1"))] {
+            t.apply(op(&from, &to), &s, &mut next, &mut ax);
+            h.progress(&reached, &next, &mut r2);
+            std::mem::swap(&mut s, &mut next);
+            std::mem::swap(&mut reached, &mut r2);
+        }
+        // Not reached: attach, the goal; needed again: at agv1 (ordered
+        // before the goal, which is not reached).
+        assert_eq!(h.value(&reached, &s), 3);
+    }
+}
