@@ -4,7 +4,7 @@ set -euo pipefail
 cd "$(dirname "$0")"
 root=..
 corpus=${BTC_CORPUS:-../../shared/corpus/ipc}
-mkdir -p corpus/{pddl,plan,rules,tree,scenario,compile}
+mkdir -p corpus/{pddl,plan,rules,tree,scenario,compile,trial}
 n=0
 for f in "$root"/examples/*/*.pddl "$root"/tests/fixtures/diagnostics/*/*.pddl; do
   cp "$f" "corpus/pddl/$((n++)).pddl"
@@ -22,6 +22,10 @@ for f in "$root"/examples/*/rules.btrules "$root"/stdlib/*.btrules "$root"/tests
 done
 for f in "$root"/examples/ariac/faults/*.toml; do cp "$f" "corpus/scenario/$((n++)).toml"; done
 for f in $(find "$root"/tests "$root"/runtime/tests -name '*.xml' | head -200); do cp "$f" "corpus/tree/$((n++)).xml"; done
+for f in "$root"/examples/ariac_cell/trials/*.yaml "$root"/agent/tests/fixtures/trials/*.yaml \
+         "$root"/examples/ariac_cell/cell.toml "$root"/tests/fixtures/diagnostics/T*/*; do
+  [ -f "$f" ] && cp "$f" "corpus/trial/$((n++)).$(basename "$f")"
+done
 btc="$root/target/debug/btc"
 if [ -x "$btc" ]; then
   for fmt in btcpp json; do

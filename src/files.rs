@@ -43,6 +43,27 @@ fn unreadable(path: &Path, e: &btc_files::ReadError) -> anyhow::Error {
     anyhow::anyhow!("[{}] cannot read `{}`: {e}", code.id, path.display())
 }
 
+/// Reads a UTF-8 file whole through the bounded reader, for readers that
+/// take their files' texts from a callback (the cell loader): every
+/// problem is the error's text.
+pub fn read_text(path: &Path) -> Result<String, String> {
+    let bytes = btc_files::read(path, MAX_FILE_BYTES).map_err(|e| {
+        let code = match e {
+            btc_files::ReadError::NotAFile { .. } => codes::FILE_NOT_REGULAR,
+            btc_files::ReadError::TooLarge { .. } => codes::FILE_TOO_LARGE,
+            btc_files::ReadError::Io(_) => codes::FILE_UNREADABLE,
+        };
+        format!("[{}] {e}", code.id)
+    })?;
+    String::from_utf8(bytes).map_err(|e| {
+        format!(
+            "it is not UTF-8: byte 0x{:02X} at offset {} is not valid",
+            e.as_bytes()[e.utf8_error().valid_up_to()],
+            e.utf8_error().valid_up_to()
+        )
+    })
+}
+
 /// [`decode`] without copying a UTF-8 file's bytes.
 fn decode_owned(bytes: Vec<u8>) -> (String, Option<DecodeProblem>) {
     let plain = !bytes.starts_with(&[0xEF, 0xBB, 0xBF])

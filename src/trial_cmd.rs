@@ -53,8 +53,9 @@ pub struct TrialArgs {
     pub format: Format,
 }
 
+/// A cell's files, through the bounded reader like every input.
 fn read_file(p: &Path) -> Result<String, String> {
-    std::fs::read_to_string(p).map_err(|e| e.to_string())
+    files::read_text(p)
 }
 
 fn load_cell(db: &mut Database, a: &TrialArgs) -> anyhow::Result<Result<Cell, Vec<Diagnostic>>> {

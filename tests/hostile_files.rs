@@ -38,6 +38,10 @@ fn input_commands() -> Vec<Vec<String>> {
         ariac("problem.pddl"),
         ariac("plan.txt"),
     );
+    let t = repo()
+        .join("examples/ariac_cell/trials/mixed.yaml")
+        .display()
+        .to_string();
     let s = |v: &[&str]| v.iter().map(|x| x.to_string()).collect::<Vec<_>>();
     vec![
         s(&["check", "PATH"]),
@@ -69,6 +73,8 @@ fn input_commands() -> Vec<Vec<String>> {
         s(&["run", &r, "--plan", &l, "--faults", "PATH"]),
         s(&["run", "--tree", "PATH", "--problem", &p]),
         s(&["run", &r, "--problem", &p, "--replan", "--faults", "PATH"]),
+        s(&["trial", "PATH"]),
+        s(&["trial", &t, "--cell", "PATH"]),
     ]
 }
 
@@ -128,12 +134,17 @@ fn output_commands() -> Vec<Vec<String>> {
         ariac("problem.pddl"),
         ariac("plan.txt"),
     );
+    let t = repo()
+        .join("examples/ariac_cell/trials/mixed.yaml")
+        .display()
+        .to_string();
     let s = |v: &[&str]| v.iter().map(|x| x.to_string()).collect::<Vec<_>>();
     vec![
         s(&["compile", &r, "--plan", &l, "--emit", "btcpp", "-o", "OUT"]),
         s(&["plan", &d, &p, "-o", "OUT", "--quiet"]),
         s(&["run", &r, "--plan", &l, "--trace", "OUT"]),
         s(&["run", &r, "--problem", &p, "--replan", "--trace", "OUT"]),
+        s(&["trial", &t, "--trace", "OUT"]),
     ]
 }
 

@@ -734,7 +734,7 @@ mod tests {
             "{}\nrule (flip ?robot ?p ?c) {{ Flip(robot: ?robot, part: ?p, container: ?c) }}\n",
             f.text(&db)
         );
-        db.set_file(f.path(&db).clone().as_str(), text);
+        db.set_file(&f.path(&db).clone(), text);
         let after = errors(&db, f);
         let log = db.take_log();
         let count = |q: &str| log.iter().filter(|l| l.starts_with(q)).count();

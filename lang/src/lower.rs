@@ -20,6 +20,7 @@ use std::collections::{BTreeMap, BTreeSet};
 
 mod action;
 mod arrange;
+mod backchain;
 
 use action::{ActionLogic, RuleEffect};
 use arrange::kb_holds;
@@ -773,16 +774,24 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
     // The plan template holds `steps` once (R022): the step nodes move into
     // it instead of being copied.
     let step_nodes = std::cell::RefCell::new(step_nodes);
+    let arrange_diags = std::cell::RefCell::new(Vec::new());
+    let goal = input.problem.goal.as_ref().map(Formula::from_ast);
+    let derived = backchain::derived_predicates(input.domain);
     let arranged = |mode: StepsMode| -> Vec<Node> {
         let nodes = std::mem::take(&mut *step_nodes.borrow_mut());
         match mode {
             StepsMode::InOrder => nodes.into_iter().flatten().collect(),
-            StepsMode::Backchained => nodes
-                .into_iter()
-                .zip(&infos)
-                .filter_map(|(n, info)| n.map(|n| (n, info)))
-                .map(|(n, info)| arrange::backchain(n, info))
-                .collect(),
+            StepsMode::Backchained => {
+                match backchain::stages(nodes, &infos, goal.as_ref(), &derived) {
+                    Ok(stages) => stages,
+                    Err(e) => {
+                        arrange_diags
+                            .borrow_mut()
+                            .push(backchain_diagnostic(e, input));
+                        Vec::new()
+                    }
+                }
+            }
             StepsMode::Parallel => vec![arrange::parallel(&nodes, &infos)],
         }
     };
@@ -810,6 +819,10 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
         }
         None => Node::sequence(arranged(StepsMode::InOrder)),
     };
+    let arrange_diags = arrange_diags.into_inner();
+    if !arrange_diags.is_empty() {
+        return Err(arrange_diags);
+    }
     root.walk(&mut |n| {
         if let Node::Leaf { id, .. } = n {
             used_kb.insert(id.clone());
@@ -843,6 +856,22 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
         steps: infos,
         world: WorldModel::from_checked(input.domain, input.dix, input.problem, input.pix),
     })
+}
+
+/// `steps backchained` on a plan it cannot regress the goal through, at the
+/// step's plan line.
+fn backchain_diagnostic(e: backchain::Breaks, input: &LowerInput) -> Diagnostic {
+    let span = input.plan.steps[input.steps[e.step].step].span;
+    Diagnostic::error(
+        codes::R_BACKCHAIN,
+        span,
+        format!(
+            "step {} makes `{}` false, which the goal or a later step needs: `steps backchained` cannot regress the goal through it",
+            e.step + 1,
+            e.what
+        ),
+    )
+    .with_hint("the plan does not reach its goal from this step on; plan again, or use `steps` to run it as written")
 }
 
 fn uses_mode(ts: &[Template], mode: StepsMode) -> bool {

@@ -4,20 +4,7 @@
 
 use btc_lang::db::{rules_diagnostics, Database};
 use btc_lang::rules::parse::{parse_rules, MAX_ITEM_DEPTH};
-use std::time::{Duration, Instant};
-
-/// Runs `f` on a thread with a small stack: deep input must be refused,
-/// not overflow it. 1 MiB holds every pass at the nesting limit (a PDDL
-/// formula level takes under 2 KiB of stack in a test build), and a tenth
-/// of what ten times the limit would need if anything recursed past it.
-fn on_small_stack<T: Send + 'static>(f: impl FnOnce() -> T + Send + 'static) -> T {
-    std::thread::Builder::new()
-        .stack_size(1 << 20)
-        .spawn(f)
-        .unwrap()
-        .join()
-        .expect("no panic, no overflow")
-}
+use btc_testkit::hostile::{assert_linear, on_small_stack};
 
 fn codes(text: &str) -> Vec<&'static str> {
     parse_rules(text, 0)
@@ -134,34 +121,18 @@ fn lexical_errors_are_capped_per_file() {
         .any(|d| d.message.contains("99900 more lexical errors")));
 }
 
-/// The fastest of three runs.
-fn time(f: impl Fn()) -> Duration {
-    (0..3)
-        .map(|_| {
-            let t = Instant::now();
-            f();
-            t.elapsed()
-        })
-        .min()
-        .unwrap()
-}
-
 /// Lexing is linear: ten times the text takes about ten times as long,
 /// not a hundred (each comment used to search back for its line's start).
 #[test]
 fn comments_on_one_long_line_lex_in_linear_time() {
-    let small = "/* c */ x ".repeat(20_000);
-    let large = "/* c */ x ".repeat(200_000);
-    let ts = time(|| {
-        btc_lang::rules::lexer::lex(&small, 0);
-    });
-    let tl = time(|| {
-        btc_lang::rules::lexer::lex(&large, 0);
-    });
-    let ratio = tl.as_secs_f64() / ts.as_secs_f64().max(1e-6);
-    assert!(
-        ratio < 30.0,
-        "10x the text took {ratio:.1}x the time ({ts:?} -> {tl:?})"
+    assert_linear(
+        "lexing comments on one line",
+        20_000,
+        30.0,
+        |n| "/* c */ x ".repeat(n),
+        |t| {
+            btc_lang::rules::lexer::lex(t, 0);
+        },
     );
 }
 

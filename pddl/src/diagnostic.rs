@@ -322,6 +322,7 @@ pub mod codes {
         R_PLAN_BLOCK = "R022", "a `plan` block that is missing, repeated or has no `steps`";
         R_BAD_ARGUMENT = "R023", "a control or decorator argument that makes no sense";
         R_EFFECT_UNBOUND = "R033", "a rule effect that reads an optional parameter a step leaves out";
+        R_BACKCHAIN = "R034", "a plan `steps backchained` cannot regress its goal through";
         // .btrules: rules that no step can match, and skips that lose effects
         R_CONTRADICTION = "R040", "a rule whose guards contradict each other, so no step matches it";
         R_GUARD_TYPE = "R041", "a type guard that the variable's type can never fit";

@@ -221,3 +221,29 @@ fn stray_words_make_a_bounded_number_of_diagnostics() {
         );
     }
 }
+
+/// "did you mean" on huge names is not quadratic in their length (a 10 MB
+/// name used to take 16 s): names and candidates past the bound go
+/// unmeasured, and a typo of a short name is still found.
+#[test]
+fn suggestions_for_huge_names_take_linear_time() {
+    use btc_pddl::diagnostic::closest;
+    btc_testkit::hostile::assert_linear(
+        "suggesting a name",
+        100_000,
+        30.0,
+        |n| {
+            (
+                "a".repeat(n),
+                ["a".repeat(n - 1), "b".repeat(n), "holds".to_owned()],
+            )
+        },
+        |(name, candidates)| {
+            assert_eq!(closest(name, candidates.iter().map(String::as_str)), None);
+            assert_eq!(
+                closest("hodls", candidates.iter().map(String::as_str)),
+                Some("holds")
+            );
+        },
+    );
+}

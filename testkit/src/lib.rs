@@ -10,6 +10,7 @@
 //! The skip line is written straight to the process's stderr, past the test
 //! harness's output capture, so `cargo test` shows it for passing tests too.
 
+pub mod hostile;
 pub mod scale;
 
 use std::io::Write;

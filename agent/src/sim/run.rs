@@ -49,8 +49,12 @@ impl Default for TrialOptions {
             check: false,
             max_attempts: 4,
             max_seconds: 3600.0,
+            // An agent replans on line, between ticks: it takes LAMA's
+            // first plan (no restarts) rather than spend the default
+            // improvement budget on every part task.
             planner: btc_planner::Options {
                 timeout: Some(std::time::Duration::from_secs(10)),
+                improve: 0,
                 ..btc_planner::Options::default()
             },
         }

@@ -1,10 +1,11 @@
-//! How the plan's steps are put together: `steps backchained` and `steps
-//! parallel` (plain `steps` is the steps in order). Both read each step's
-//! ground conditions and effects from its [`StepInfo`], so a rule's
-//! `effect` orders and guards steps exactly as it changes the KB.
+//! How the plan's steps are put together for `steps parallel` (plain
+//! `steps` is the steps in order; `steps backchained` is in
+//! [`super::backchain`]). Both read each step's ground conditions and
+//! effects from its [`StepInfo`], so a rule's `effect` orders and guards
+//! steps exactly as it changes the KB.
 
 use btc_ir::*;
-use btc_pddl::logic::{Effect, Formula, Literal};
+use btc_pddl::logic::{Formula, Literal};
 use std::collections::BTreeSet;
 
 /// A KB leaf: `KbHolds(formula)` or `KbApply(effect)`.
@@ -17,48 +18,6 @@ pub(super) fn kb_holds(f: Formula, name: Option<String>) -> Node {
             name: "formula".into(),
             value: PortValue::Formula(f),
         }],
-    }
-}
-
-/// A step's effects, start and end, as one.
-fn step_effect(info: &StepInfo) -> Option<Effect> {
-    Effect::conjunction(
-        info.eff_start
-            .iter()
-            .chain(&info.eff_end)
-            .cloned()
-            .collect(),
-    )
-}
-
-/// `Fallback(effects already hold, Sequence(preconditions hold, step))`.
-pub(super) fn backchain(step: Node, info: &StepInfo) -> Node {
-    let done = step_effect(info)
-        .and_then(|e| e.outcome())
-        .filter(|l| !l.is_empty())
-        .and_then(|l| Formula::conjunction(l.iter().map(Literal::to_formula).collect()));
-    let Some(done) = done else {
-        return step; // no plain effect to test: always run it
-    };
-    let mut seq = Vec::new();
-    if let Some(pre) = &info.pre_start {
-        seq.push(kb_holds(
-            pre.clone(),
-            Some(format!("step {} ready?", info.index + 1)),
-        ));
-    }
-    seq.push(step);
-    Node::Control {
-        control: ControlKind::Fallback,
-        name: Some(format!("step {} {}", info.index + 1, info.display())),
-        children: vec![
-            kb_holds(done, Some(format!("step {} done?", info.index + 1))),
-            Node::Control {
-                control: ControlKind::Sequence,
-                name: None,
-                children: seq,
-            },
-        ],
     }
 }
 

@@ -181,7 +181,30 @@ impl World {
                 }
                 None => String::new(),
             },
-            Cond::Or(_) => "none of the alternatives of an `or` holds".to_owned(),
+            Cond::Or(ps) => {
+                // Each alternative's reason, once: a long disjunction (the
+                // remaining-plan conditions of `steps backchained`) often
+                // fails for a handful of facts.
+                let mut whys: Vec<String> = Vec::new();
+                for p in ps {
+                    let why = self.why(s, p, b, duration, &mut Vec::new());
+                    if !whys.contains(&why) {
+                        whys.push(why);
+                    }
+                }
+                const SHOWN: usize = 12;
+                let more = whys.len().saturating_sub(SHOWN);
+                whys.truncate(SHOWN);
+                let mut out = "none of the alternatives of an `or` holds".to_owned();
+                if !whys.is_empty() {
+                    out.push_str(": ");
+                    out.push_str(&whys.join("; "));
+                }
+                if more > 0 {
+                    out.push_str(&format!("; and {more} more"));
+                }
+                out
+            }
             Cond::Imply(_, r) => {
                 path.push(1);
                 let why = self.why(s, r, b, duration, path);

@@ -1,0 +1,53 @@
+//! Helpers for tests that feed btc input written to break it: deep nesting
+//! run on a small stack, and the shape of the time a size takes (a ratio of
+//! two sizes, never a wall-clock figure that depends on the machine).
+
+use std::time::{Duration, Instant};
+
+/// Runs `f` on a thread with a 1 MiB stack: deep input must be refused,
+/// not overflow it. 1 MiB holds every pass at the nesting limit, and is a
+/// tenth of what ten times the limit would need if anything recursed past
+/// it. Panics (failing the test) if `f` panics.
+pub fn on_small_stack<T: Send + 'static>(f: impl FnOnce() -> T + Send + 'static) -> T {
+    std::thread::Builder::new()
+        .stack_size(1 << 20)
+        .spawn(f)
+        .expect("a thread")
+        .join()
+        .expect("no panic, no overflow")
+}
+
+/// The fastest of three runs of `f`.
+pub fn fastest(f: impl Fn()) -> Duration {
+    (0..3)
+        .map(|_| {
+            let t = Instant::now();
+            f();
+            t.elapsed()
+        })
+        .min()
+        .expect("three runs")
+}
+
+/// Asserts that `f` on ten times the input takes less than `bound` times
+/// as long as on the input: linear work gives about 10, quadratic 100.
+/// `make(n)` builds the input of size `n`.
+pub fn assert_linear<I>(
+    what: &str,
+    n: usize,
+    bound: f64,
+    make: impl Fn(usize) -> I,
+    f: impl Fn(&I),
+) {
+    let small = make(n);
+    let large = make(10 * n);
+    // Warm up caches and lazy statics before measuring.
+    f(&small);
+    let ts = fastest(|| f(&small));
+    let tl = fastest(|| f(&large));
+    let ratio = tl.as_secs_f64() / ts.as_secs_f64().max(1e-6);
+    assert!(
+        ratio < bound,
+        "{what}: 10x the input took {ratio:.1}x the time ({ts:?} -> {tl:?})"
+    );
+}
