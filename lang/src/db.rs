@@ -6,7 +6,7 @@
 use crate::path::{AsFilePath, FilePath};
 use crate::project::ReadFailure;
 use crate::rules::actions::ActionIndex;
-use crate::rules::check::{check_item, Decls, DomainCtx};
+use crate::rules::check::{check_item, Decls, DomainCtx, VarTypes};
 use crate::rules::file_checks::{self, Finding, ItemHead, ItemUses, RuleFacts};
 use crate::rules::parse::{parse_item_text, parse_rules_with, shift};
 use crate::rules::{ImportTarget, Item, ItemNode, ParsedRules};
@@ -465,6 +465,18 @@ pub fn item_diagnostics<'db>(db: &'db dyn Db, item: RulesItem<'db>) -> Vec<Diagn
         domain_ctx(db, file),
         file_id(db, file),
     )
+}
+
+/// A rule's variables with the types the checker gives them (empty for
+/// items that are no rules): what the language server shows for a
+/// `?variable` in hovers, completions and inlay hints.
+#[salsa::tracked(returns(ref))]
+pub fn rule_var_types<'db>(db: &'db dyn Db, item: RulesItem<'db>) -> Vec<VarTypes> {
+    let Item::Rule(r) = item.item(db) else {
+        return Vec::new();
+    };
+    let file = item.file(db);
+    crate::rules::check::rule_var_types(r, declarations(db, file), domain_ctx(db, file))
 }
 
 /// What the file-level checks need of an item's head (nothing of a body).

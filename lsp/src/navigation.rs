@@ -38,7 +38,7 @@ pub fn hover(a: &Analysis, offset: usize) -> Option<Hover> {
         }
         Symbol::Var { item, name } => match &a.items[*item].item {
             Item::Rule(r) => {
-                let types = a.var_types(r, name);
+                let types = a.var_types(*item, name);
                 let pos = r.pattern.params.iter().position(|p| p.var.text == *name);
                 match (pos, types.is_empty()) {
                     (Some(p), false) => format!(
