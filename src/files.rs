@@ -140,7 +140,12 @@ pub fn unreadable_job_file(e: btc_lang::project::job::Unreadable) -> anyhow::Err
 /// Writes an output file (`-o`, `fmt`): atomically for a regular file,
 /// keeping its mode, owner and links; in place for special files.
 pub fn write_atomically(path: &Path, text: &str) -> anyhow::Result<()> {
-    btc_files::write(path, text.as_bytes())
+    write_bytes_atomically(path, text.as_bytes())
+}
+
+/// [`write_atomically`] for bytes.
+pub fn write_bytes_atomically(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
+    btc_files::write(path, bytes)
         .map_err(|e| anyhow::anyhow!("cannot write `{}`: {e}", path.display()))
 }
 

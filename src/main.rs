@@ -1,6 +1,7 @@
 //! `btc`: the command line. Parses arguments, reads files, calls the
 //! library and prints; nothing else lives here.
 
+mod executor_cmd;
 mod files;
 mod paths;
 mod pddl_cmd;
@@ -101,6 +102,27 @@ enum Command {
         #[arg(long, value_enum, default_value_t)]
         format: Format,
     },
+    /// Write a C++ executor for BehaviorTree.CPP from a rules file: a
+    /// CMake project with a node class per declared action and condition
+    /// (nodes.hpp, yours: never overwritten, only appended to), the
+    /// generated bases, a main that runs a compiled tree, and btc's support
+    /// library.
+    Executor {
+        rules: PathBuf,
+        /// The folder to write (created when missing).
+        #[arg(short = 'o', long = "output")]
+        output: PathBuf,
+        /// The C++ namespace and executable name (`NAME_executor`); default:
+        /// the rules file's folder name.
+        #[arg(long)]
+        name: Option<String>,
+        /// Write nothing: report what is out of date (exit 1 if anything is).
+        #[arg(long)]
+        check: bool,
+        /// How to print diagnostics.
+        #[arg(long, value_enum, default_value_t)]
+        format: Format,
+    },
     /// Format `.btrules` files in place.
     Fmt {
         #[arg(required = true)]
@@ -187,18 +209,22 @@ enum EmitFormat {
     Dot,
     Mermaid,
     Commands,
+    /// The problem's world for btc's C++ knowledge base (`btc executor`).
+    Kb,
 }
 
-impl From<EmitFormat> for btc_emit::Format {
+impl From<EmitFormat> for rules_cmd::Output {
     fn from(f: EmitFormat) -> Self {
         use btc_emit::Format as F;
+        use rules_cmd::Output::{Kb, Tree};
         match f {
-            EmitFormat::Btcpp => F::Btcpp,
-            EmitFormat::Pytrees => F::Pytrees,
-            EmitFormat::Json => F::Json,
-            EmitFormat::Dot => F::Dot,
-            EmitFormat::Mermaid => F::Mermaid,
-            EmitFormat::Commands => F::Commands,
+            EmitFormat::Btcpp => Tree(F::Btcpp),
+            EmitFormat::Pytrees => Tree(F::Pytrees),
+            EmitFormat::Json => Tree(F::Json),
+            EmitFormat::Dot => Tree(F::Dot),
+            EmitFormat::Mermaid => Tree(F::Mermaid),
+            EmitFormat::Commands => Tree(F::Commands),
+            EmitFormat::Kb => Kb,
         }
     }
 }
@@ -268,6 +294,19 @@ fn main() -> ExitCode {
                 node_module,
             },
             allow_invalid_plan,
+            format,
+        }),
+        Command::Executor {
+            rules,
+            output,
+            name,
+            check,
+            format,
+        } => executor_cmd::run(&executor_cmd::Args {
+            rules: &rules,
+            out: &output,
+            name: name.as_deref(),
+            check,
             format,
         }),
         Command::Fmt { files, check } => rules_cmd::fmt(&files, check),

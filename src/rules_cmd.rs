@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// Loads a rules file and everything it names from disk.
-fn load_rules(db: &mut Database, path: &Path) -> anyhow::Result<SourceFile> {
+pub fn load_rules(db: &mut Database, path: &Path) -> anyhow::Result<SourceFile> {
     project::load_rules(db, &files::Disk, &FilePath::new(path)).map_err(|why| {
         files::unreadable_job_file(project::job::Unreadable {
             path: FilePath::new(path),
@@ -71,12 +71,21 @@ pub fn check(path: &Path, format: Format) -> anyhow::Result<ExitCode> {
     })
 }
 
+/// What `btc compile` writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Output {
+    /// The compiled tree in a format.
+    Tree(emit::Format),
+    /// The problem's world as a `.kb` file (for the C++ knowledge base).
+    Kb,
+}
+
 pub struct CompileArgs {
     pub rules: PathBuf,
     pub plan: PathBuf,
     pub problem: Option<PathBuf>,
     pub domain: Option<PathBuf>,
-    pub emit: emit::Format,
+    pub emit: Output,
     pub output: Option<PathBuf>,
     pub options: emit::Options,
     pub allow_invalid_plan: bool,
@@ -192,15 +201,21 @@ pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
     };
     let text = match (&a.output, a.emit) {
         // A JSON IR records its PDDL files relative to itself.
-        (Some(out), emit::Format::Json) => {
+        (Some(out), Output::Tree(f @ emit::Format::Json)) => {
             let mut ir = ir.clone();
             let dir = out.parent().unwrap_or(Path::new(""));
             for p in [&mut ir.domain, &mut ir.problem] {
                 *p = crate::paths::text(&crate::paths::relative_to(Path::new(p.as_str()), dir));
             }
-            emit::emit(&ir, a.emit, &a.options)
+            emit::emit(&ir, f, &a.options)
         }
-        _ => emit::emit(ir, a.emit, &a.options),
+        (_, Output::Tree(f)) => emit::emit(ir, f, &a.options),
+        (_, Output::Kb) => match db::JobWorld::of(&job.db, job.job()) {
+            Some(w) => emit::kb::emit(w.domain, w.dix, w.problem, w.pix),
+            None => anyhow::bail!(
+                "`--emit kb` needs the PDDL problem: pass `--problem PROBLEM` or name it in the rules file"
+            ),
+        },
     };
     let steps = ir.steps.iter().filter(|s| !s.skipped).count();
     let what = format!(

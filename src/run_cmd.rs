@@ -50,6 +50,10 @@ pub struct RunArgs {
     /// Write every status change here, as JSON Lines (atomically).
     #[arg(long)]
     pub trace: Option<PathBuf>,
+    /// Write the run for Groot2 to replay, in BehaviorTree.CPP's
+    /// FileLogger2 format (the name must end in `.btlog`).
+    #[arg(long, conflicts_with = "replan", value_parser = btlog_path)]
+    pub btlog: Option<PathBuf>,
     /// Ticks an action leaf stays RUNNING before it succeeds.
     #[arg(long, default_value_t = 1)]
     pub ticks_per_action: u32,
@@ -68,6 +72,16 @@ pub struct RunArgs {
     pub allow_invalid_plan: bool,
     #[arg(long, value_enum, default_value_t)]
     pub format: Format,
+}
+
+/// `--btlog`'s value: Groot2 and BT.CPP's FileLogger2 open only `.btlog`.
+fn btlog_path(s: &str) -> Result<PathBuf, String> {
+    let p = PathBuf::from(s);
+    if p.extension().is_some_and(|e| e == "btlog") {
+        Ok(p)
+    } else {
+        Err("a Groot2 replay file's name ends in `.btlog` (Groot2 opens only those)".into())
+    }
 }
 
 /// A runtime error as a diagnostic on the file it is about; the span covers
@@ -312,8 +326,12 @@ fn execute(
     let opts = Options {
         ticks_per_action: a.ticks_per_action,
         ms_per_tick: if a.tick_ms > 0 { a.tick_ms } else { 10 },
-        trace: a.trace.is_some(),
+        trace: a.trace.is_some() || a.btlog.is_some(),
     };
+    let ms_per_tick = opts.ms_per_tick;
+    let started = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| i64::try_from(d.as_micros()).unwrap_or(i64::MAX));
     let mut engine = match Engine::build(doc, kb, opts) {
         Ok(e) => e,
         Err(e) => return fail(&[diagnostic(&e, tree_file, sources)], sources, a.format),
@@ -367,6 +385,12 @@ fn execute(
         t.finish()
             .map_err(|e| anyhow::anyhow!("cannot write `{}`: {e}", path.display()))?;
     }
+    if let Some(path) = &a.btlog {
+        match btc_runtime::btlog::write(doc, &engine, status, ms_per_tick, started) {
+            Ok(bytes) => files::write_bytes_atomically(path, &bytes)?,
+            Err(e) => return fail(&[diagnostic(&e, tree_file, sources)], sources, a.format),
+        }
+    }
     let summary = engine.summary(status);
     match a.format {
         Format::Json => {
@@ -376,6 +400,9 @@ fn execute(
                     o.insert("commands".into(), serde_json::to_value(c)?);
                 }
                 o.insert("problem".into(), problem.into());
+            }
+            if let (Some(o), Some(kb)) = (v.as_object_mut(), &engine.kb) {
+                o.insert("kb".into(), serde_json::to_value(kb.snapshot())?);
             }
             println!("{}", serde_json::to_string_pretty(&v)?);
         }

@@ -311,3 +311,22 @@ fn json_diagnostics_carry_their_fixes() {
         .unwrap();
     assert!(r014.get("fixes").is_none());
 }
+
+#[test]
+fn a_palette_port_type_that_a_rule_does_not_fit_is_shown_in_the_palette() {
+    // tests/fixtures/palette: MoveTo's `target` is an int in nodes.xml.
+    let out = btc(&["check", "tests/fixtures/palette/rules.btrules"]);
+    assert_eq!(out.status.code(), Some(1));
+    insta::assert_snapshot!(String::from_utf8_lossy(&out.stderr));
+    let out = btc(&[
+        "check",
+        "tests/fixtures/palette/rules.btrules",
+        "--format",
+        "json",
+    ]);
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let d = &doc["diagnostics"][0];
+    assert_eq!(d["code"], "R004");
+    assert_eq!(d["labels"][0]["file"], "tests/fixtures/palette/nodes.xml");
+    assert_eq!(d["labels"][0]["start"]["line"], 11);
+}

@@ -51,6 +51,10 @@ const NO_FIXTURE: &[(&str, &str)] = &[
         "a file over 1 GiB: files::load checks the size first",
     ),
     (
+        "X030",
+        "a tree of more than 65,535 nodes: runtime/src/btlog.rs tests it",
+    ),
+    (
         "F006",
         "the language server only: lsp/tests/protocol.rs opens a document over the limit",
     ),

@@ -282,6 +282,59 @@ fn an_xml_tree_checks_step_preconditions_from_the_domain() {
     );
 }
 
+#[test]
+fn btlog_writes_a_groot2_replay_of_the_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("run.btlog");
+    let out = btc(&[
+        "run",
+        "examples/ariac/rules.btrules",
+        "--plan",
+        "examples/ariac/plan.txt",
+        "--btlog",
+        log.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0));
+    let b = std::fs::read(&log).unwrap();
+    assert_eq!(&b[..19], b"BTCPP4-FileLogger2\x01");
+    let n = i32::from_le_bytes(b[19..23].try_into().unwrap()) as usize;
+    let xml = std::str::from_utf8(&b[23..23 + n]).unwrap();
+    // The tree as BT.CPP's WriteTreeToXML: instances, uids, ports, models.
+    assert!(xml.contains(r#"<BehaviorTree ID="rule_grasp" _fullpath="rule_grasp::10">"#));
+    assert!(xml.contains(
+        r#"<KbStep name="step 2: (grasp floor_robot battery_red bin1)" _uid="9" step="2""#
+    ));
+    assert!(xml.contains(r#"<Action ID="MoveTo">"#));
+    // One 9-byte record per status change (the trace's), plus the root's
+    // reset after the last tick.
+    let trace = dir.path().join("run.jsonl");
+    btc(&[
+        "run",
+        "examples/ariac/rules.btrules",
+        "--plan",
+        "examples/ariac/plan.txt",
+        "--trace",
+        trace.to_str().unwrap(),
+    ]);
+    let changes = std::fs::read_to_string(&trace)
+        .unwrap()
+        .lines()
+        .filter(|l| l.contains("\"from\""))
+        .count();
+    assert_eq!(b.len() - (31 + n), 9 * (changes + 1));
+    // Groot2 opens only `.btlog` files.
+    let bad = btc(&[
+        "run",
+        "examples/ariac/rules.btrules",
+        "--plan",
+        "examples/ariac/plan.txt",
+        "--btlog",
+        "run.log",
+    ]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains(".btlog"));
+}
+
 /// `btc` with the working directory `dir`.
 fn btc_in(dir: &std::path::Path, args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_btc"))

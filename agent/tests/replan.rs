@@ -50,10 +50,12 @@ fn the_state_after_a_malfunction_is_the_next_plans_initial_state() {
     // Ticks go on: the repair is waited for, then the second plan runs.
     assert_eq!(b.start_tick, a.end_tick + a.waited_ticks);
     assert_eq!(s.ticks, b.end_tick);
-    // The malfunction fired once, at its step of the first plan, though the
-    // second plan also has a step 2.
+    // The malfunction fired once, at its step of the first plan (tick 2; the
+    // grasp's retry tries again at tick 3, where the plan's monitor fails),
+    // though the second plan also has a step 2.
     assert_eq!(s.faults.len(), 1);
-    assert_eq!(s.faults[0].met_at, Some(a.end_tick));
+    assert_eq!(s.faults[0].met_at, Some(2));
+    assert_eq!(a.end_tick, 3);
     assert_eq!(s.faults[0].ended, "recovered");
 }
 

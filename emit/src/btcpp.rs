@@ -285,20 +285,25 @@ fn node(x: &mut Xml, n: &Node, ir: &TreeIr) {
             });
             number(x, "step", step + 1);
             x.attr_display("start_effect", info.and_then(|s| s.eff_start.as_ref()))
-                .attr_display("end_effect", info.and_then(|s| s.eff_end.as_ref()))
-                .close(false);
+                .attr_display("end_effect", info.and_then(|s| s.eff_end.as_ref()));
+            // The step's conditions, so an executor that does not read the
+            // domain checks what `btc run` checks (written only when there
+            // are some: most steps have just a precondition).
+            if let Some(s) = info {
+                for (key, cond) in [
+                    ("start_condition", &s.pre_start),
+                    ("over_all_condition", &s.pre_over_all),
+                    ("end_condition", &s.pre_end),
+                ] {
+                    if cond.is_some() {
+                        x.attr_display(key, cond.as_ref());
+                    }
+                }
+            }
+            x.close(false);
             node(x, child, ir);
             x.end("KbStep");
         }
-    }
-}
-
-fn port_type(ty: &str) -> &str {
-    match ty {
-        "int" => "int",
-        "float" => "double",
-        "bool" => "bool",
-        _ => "std::string",
     }
 }
 
@@ -349,7 +354,7 @@ pub fn emit(ir: &TreeIr, inline: bool) -> String {
             };
             x.open(kind)
                 .attr("name", &p.name)
-                .attr("type", port_type(&p.ty));
+                .attr("type", p.cpp_type());
             if !matches!(p.ty.as_str(), "int" | "float" | "bool" | "string") {
                 x.attr("description", &format!("a PDDL object of type {}", p.ty));
             }
@@ -363,13 +368,16 @@ pub fn emit(ir: &TreeIr, inline: bool) -> String {
             .attr("ID", "KbStep")
             .attr(
                 "description",
-                "a plan step: applies its PDDL effects to the KB when it starts and when its child succeeds",
+                "a plan step: applies its PDDL effects to the KB when it starts and when its child succeeds; its conditions are checked when it starts (before at-start effects), while it runs and when its child succeeds",
             )
             .close(false);
         for (name, ty) in [
             ("step", "int"),
             ("start_effect", "std::string"),
             ("end_effect", "std::string"),
+            ("start_condition", "std::string"),
+            ("over_all_condition", "std::string"),
+            ("end_condition", "std::string"),
         ] {
             x.open("input_port")
                 .attr("name", name)

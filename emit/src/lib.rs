@@ -5,6 +5,8 @@
 pub mod btcpp;
 pub mod commands;
 pub mod dot;
+pub mod executor;
+pub mod kb;
 pub mod pytrees;
 
 use btc_ir::TreeIr;

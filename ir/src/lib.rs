@@ -12,6 +12,7 @@
 use btc_pddl::logic::{Effect, Formula};
 use btc_pddl::world::WorldModel;
 use serde::{Deserialize, Serialize};
+use std::collections::HashSet;
 
 pub mod json;
 mod nodes;
@@ -142,6 +143,20 @@ pub struct PortModel {
     pub ty: String,
 }
 
+impl PortModel {
+    /// The C++ type BT.CPP holds the port's values in (and names in a
+    /// TreeNodesModel): `int`, `double` for `float`, `bool`, and
+    /// `std::string` for strings and PDDL objects.
+    pub fn cpp_type(&self) -> &'static str {
+        match self.ty.as_str() {
+            "int" => "int",
+            "float" => "double",
+            "bool" => "bool",
+            _ => "std::string",
+        }
+    }
+}
+
 /// A leaf node type the tree uses, with its ports (BT.CPP's TreeNodesModel).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct NodeModel {
@@ -223,10 +238,78 @@ impl TreeIr {
 
     /// The main tree with every subtree call expanded.
     pub fn inlined(&self) -> Node {
-        self.inline_node(&self.root, &[], 0)
+        self.inline_node(&self.root, &[], 0, None)
     }
 
-    fn inline_node(&self, n: &Node, args: &[Port], depth: usize) -> Node {
+    /// Writes the calls of the trees in `ids` out in place (each call
+    /// becomes the called tree's body, its arguments filled in) and drops
+    /// those trees; calls of other trees stay calls.
+    pub fn expand_calls(&mut self, ids: &HashSet<String>) {
+        if ids.is_empty() {
+            return;
+        }
+        let only = Some(ids);
+        self.root = self.inline_node(&self.root, &[], 0, only);
+        let trees: Vec<TreeDef> = self
+            .trees
+            .iter()
+            .filter(|t| !ids.contains(&t.id))
+            .map(|t| TreeDef {
+                id: t.id.clone(),
+                params: t.params.clone(),
+                root: self.inline_node(&t.root, &[], 0, only),
+            })
+            .collect();
+        self.trees = trees;
+    }
+
+    /// The trees whose `Timeout` takes its duration from a port, and the
+    /// trees that call them. BehaviorTree.CPP 4.10 stores a number passed
+    /// to a `<SubTree>` port as an `int` entry while `Timeout`'s `msec`
+    /// port is `unsigned`, so such a tree would not load there: lowering
+    /// expands these calls (`expand_calls`) for every target alike, so
+    /// that every executor runs the same tree.
+    pub fn trees_timed_by_port(&self) -> HashSet<String> {
+        fn uses(n: &Node, set: &HashSet<String>) -> bool {
+            match n {
+                Node::Decorator {
+                    decorator, child, ..
+                } => {
+                    matches!(
+                        decorator,
+                        DecoratorKind::Timeout {
+                            ms: Count::Param { .. }
+                        }
+                    ) || uses(child, set)
+                }
+                Node::Control { children, .. } => children.iter().any(|c| uses(c, set)),
+                Node::Step { child, .. } => uses(child, set),
+                Node::SubTree { id, .. } => set.contains(id),
+                Node::Leaf { .. } => false,
+            }
+        }
+        let mut set = HashSet::new();
+        // A fixpoint: each pass adds the callers of the trees found so far.
+        loop {
+            let before = set.len();
+            for t in &self.trees {
+                if !set.contains(&t.id) && uses(&t.root, &set) {
+                    set.insert(t.id.clone());
+                }
+            }
+            if set.len() == before {
+                return set;
+            }
+        }
+    }
+
+    fn inline_node(
+        &self,
+        n: &Node,
+        args: &[Port],
+        depth: usize,
+        only: Option<&HashSet<String>>,
+    ) -> Node {
         let subst = |ports: &[Port]| -> Vec<Port> {
             ports
                 .iter()
@@ -246,7 +329,7 @@ impl TreeIr {
                 name: name.as_ref().map(|s| interpolate(s, args)),
                 children: children
                     .iter()
-                    .map(|c| self.inline_node(c, args, depth))
+                    .map(|c| self.inline_node(c, args, depth, only))
                     .collect(),
             },
             Node::Decorator {
@@ -262,7 +345,7 @@ impl TreeIr {
                     _ => decorator.clone(),
                 },
                 name: name.as_ref().map(|s| interpolate(s, args)),
-                child: Box::new(self.inline_node(child, args, depth)),
+                child: Box::new(self.inline_node(child, args, depth, only)),
             },
             Node::Leaf {
                 leaf,
@@ -277,11 +360,11 @@ impl TreeIr {
             },
             Node::Step { step, child } => Node::Step {
                 step: *step,
-                child: Box::new(self.inline_node(child, args, depth)),
+                child: Box::new(self.inline_node(child, args, depth, only)),
             },
             Node::SubTree { id, ports } => match self.tree(id) {
-                Some(def) if depth < MAX_CALL_DEPTH => {
-                    self.inline_node(&def.root, &subst(ports), depth + 1)
+                Some(def) if depth < MAX_CALL_DEPTH && only.is_none_or(|ids| ids.contains(id)) => {
+                    self.inline_node(&def.root, &subst(ports), depth + 1, only)
                 }
                 _ => Node::SubTree {
                     id: id.clone(),

@@ -214,9 +214,26 @@ pub fn file_id(_db: &dyn Db, f: SourceFile) -> FileId {
 /// edit re-parses only the items whose text it changed.
 #[salsa::tracked(returns(ref))]
 pub fn parsed_rules(db: &dyn Db, file: SourceFile) -> ParsedRules {
+    if is_palette(file.path(db)) {
+        let (items, diagnostics) =
+            crate::rules::palette::parse_palette(file.text(db), file_id(db, file));
+        return ParsedRules {
+            items,
+            comments: Vec::new(),
+            diagnostics,
+        };
+    }
     parse_rules_with(file.text(db), file_id(db, file), |text| {
         parsed_item(db, ItemText::new(db, file, text.to_owned())).clone()
     })
+}
+
+/// Whether an imported file is a BT.CPP node palette (`.xml`) rather than
+/// rules.
+pub fn is_palette(path: &FilePath) -> bool {
+    path.as_path()
+        .and_then(std::path::Path::extension)
+        .is_some_and(|e| e.eq_ignore_ascii_case("xml"))
 }
 
 /// The text of one top-level item of a rules file.
@@ -552,6 +569,12 @@ pub fn rules_diagnostics(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
     let parsed = parsed_rules(db, file);
     let mut out = parsed.diagnostics.clone();
     out.extend(import_closure(db, file).1.iter().cloned());
+    // A palette's problems are reported with the file that imports it.
+    for &f in import_closure(db, file).0.iter().skip(1) {
+        if is_palette(f.path(db)) {
+            out.extend(parsed_rules(db, f).diagnostics.iter().cloned());
+        }
+    }
     for item in rules_items(db, file) {
         let offset = item.offset(db);
         out.extend(

@@ -7,6 +7,7 @@
 //! read files and hand their texts to [`db`].
 
 pub mod db;
+pub mod declared;
 pub mod lower;
 pub mod path;
 pub mod project;

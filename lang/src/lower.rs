@@ -845,7 +845,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
         .collect();
     used_nodes.extend(used_kb);
     let nodes = node_models(input.decls, &used_nodes);
-    Ok(TreeIr {
+    let mut ir = TreeIr {
         version: IR_VERSION,
         domain: input.domain_path.clone(),
         problem: input.problem_path.clone(),
@@ -855,7 +855,10 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
         nodes,
         steps: infos,
         world: WorldModel::from_checked(input.domain, input.dix, input.problem, input.pix),
-    })
+    };
+    let expand = ir.trees_timed_by_port();
+    ir.expand_calls(&expand);
+    Ok(ir)
 }
 
 /// `steps backchained` on a plan it cannot regress the goal through, at the
@@ -948,29 +951,34 @@ fn node_models(decls: &Decls, used: &BTreeSet<String>) -> Vec<NodeModel> {
     used.iter()
         .filter_map(|id| {
             let n = decls.nodes.get(id).cloned().or_else(|| kb_decl(id))?;
-            Some(NodeModel {
-                id: id.clone(),
-                kind: match n.kind {
-                    NodeKind::Action => LeafKind::Action,
-                    NodeKind::Condition => LeafKind::Condition,
-                },
-                ports: n
-                    .ports
-                    .iter()
-                    .map(|p| PortModel {
-                        name: p.name.text.clone(),
-                        direction: if p.out {
-                            PortDirection::Output
-                        } else {
-                            PortDirection::Input
-                        },
-                        ty: p.ty.text.clone(),
-                    })
-                    .collect(),
-                formula: n.formula.as_ref().map(Formula::from_ast),
-            })
+            Some(node_model(id, &n))
         })
         .collect()
+}
+
+/// The IR's model of a declared node: its kind, ports and formula.
+pub fn node_model(id: &str, n: &NodeDecl) -> NodeModel {
+    NodeModel {
+        id: id.to_owned(),
+        kind: match n.kind {
+            NodeKind::Action => LeafKind::Action,
+            NodeKind::Condition => LeafKind::Condition,
+        },
+        ports: n
+            .ports
+            .iter()
+            .map(|p| PortModel {
+                name: p.name.text.clone(),
+                direction: if p.out {
+                    PortDirection::Output
+                } else {
+                    PortDirection::Input
+                },
+                ty: p.ty.text.clone(),
+            })
+            .collect(),
+        formula: n.formula.as_ref().map(Formula::from_ast),
+    }
 }
 
 /// The `std::kb` declarations btc itself emits, available without import.

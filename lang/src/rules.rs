@@ -8,6 +8,7 @@ pub mod fmt;
 pub mod lexer;
 pub mod matching;
 pub mod name;
+pub mod palette;
 pub mod parse;
 pub mod reach;
 pub mod skip;

@@ -48,11 +48,29 @@ fn decorator_arguments_take_port_values() {
     let job = CompileJob::new(&db, f, plan, Some(problem), None);
     let ir = compile(&db, job).as_ref().unwrap();
     let xml = emit(ir, Format::Btcpp, &Options::default());
-    // The move rule's time limit depends on the step: a port of its tree,
-    // which each step's call fills in with the table's number.
-    assert!(xml.contains("<Timeout msec=\"{"), "{xml}");
-    assert!(xml.contains("=\"6000\""), "the move to agv1: {xml}");
-    assert!(xml.contains("=\"1500\""), "the move to bin1: {xml}");
+    // The grasp rule's retry count depends on the step: a port of its
+    // tree, which each step's call fills in.
+    assert!(
+        xml.contains("<RetryUntilSuccessful num_attempts=\"{times}\""),
+        "{xml}"
+    );
+    assert!(
+        xml.contains("<SubTree ID=\"rule_grasp\" times=\"3\""),
+        "{xml}"
+    );
+    // The move rule's time limit depends on the step too, but BT.CPP would
+    // pass it to `Timeout` as an `int` where it takes an `unsigned`: the
+    // rule's tree is written out at each step, with the step's number.
+    assert!(
+        xml.contains("<Timeout msec=\"6000\""),
+        "the move to agv1: {xml}"
+    );
+    assert!(
+        xml.contains("<Timeout msec=\"1500\""),
+        "the move to bin1: {xml}"
+    );
+    assert!(!xml.contains("msec=\"{"), "{xml}");
+    assert!(!xml.contains("rule_move"), "{xml}");
     // The same number for every step stays a number.
     assert!(xml.contains("<Timeout msec=\"100\""), "{xml}");
     // The inlined tree has the step's number in place.

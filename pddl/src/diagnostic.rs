@@ -330,6 +330,9 @@ pub mod codes {
         R_GUARD_OBJECT = "R043", "a guard comparing a variable with an object that can never stand there";
         R_SKIP_CHANGES = "R044", "a `=> skip` rule for steps whose effects change the world";
         R_TOO_DEEP = "R060", "a template nested deeper than btc supports";
+        // Node palettes imported from BT.CPP XML (`import "nodes.xml"`)
+        R_PALETTE = "R070", "an imported node palette that is not BT.CPP XML with a <TreeNodesModel>";
+        R_PALETTE_TYPE = "R071", "a palette port whose C++ type btc cannot check";
         // Running trees (btc run)
         X_TREE_SYNTAX = "X001", "a behavior tree file that is not BT.CPP v4 XML or btc's JSON IR";
         X_UNKNOWN_NODE = "X002", "a tree node that is neither built in nor declared";
@@ -341,6 +344,11 @@ pub mod codes {
         X_REPLAN_UNSOLVABLE = "X008", "a goal that replanning cannot reach after a fault";
         X_REPLAN_LIMIT = "X009", "a closed loop that stopped at its replan or tick limit";
         X_WORLD = "X010", "a JSON IR whose world is missing or does not fit together";
+        X_BTLOG = "X030", "a run that a Groot2 `.btlog` file cannot hold";
+        // The C++ executor for BehaviorTree.CPP (`btc executor`)
+        C_CLASS_NAME = "C001", "a node whose name cannot become a C++ class of the executor";
+        C_REGISTERED = "C002", "a node that BehaviorTree.CPP or btc's support library registers already";
+        C_STALE_CLASS = "C003", "a class in the executor's nodes.hpp for a node the rules no longer declare";
         // ARIAC trials (btc trial)
         TRIAL_SYNTAX = "T001", "a trial file that is not YAML btc reads";
         TRIAL_MISSING = "T002", "a trial field the ARIAC 2023 format requires is missing";

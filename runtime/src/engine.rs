@@ -8,7 +8,7 @@ use crate::controller::{Command, Controller};
 use crate::error::LoadError;
 use crate::faults::FaultRt;
 use crate::kb::{ConditionId, EffectId, FormulaId, Kb};
-use crate::spec::{default_name, Amount, Kind, SNode, TreeDoc};
+use crate::spec::{default_name, Amount, Kind, SNode, StepConditions, TreeDoc};
 use btc_ir::{LeafKind, NodeModel, PortValue};
 use btc_pddl::diagnostic::{codes, did_you_mean};
 use btc_pddl::logic::{self, Binding, Effect, Formula, Name, Terms};
@@ -176,6 +176,8 @@ pub(crate) struct PortBind {
 pub(crate) struct ActionInfo {
     pub id: Box<str>,
     pub ports: (u32, u32),
+    /// The embedder's implementation ([`Engine::set_action_handler`]).
+    pub handler: Option<u32>,
 }
 
 pub(crate) struct CondInfo {
@@ -237,7 +239,8 @@ pub struct FaultRecord {
     pub node: u32,
     pub node_id: String,
     pub node_name: String,
-    /// 1-based plan step.
+    /// 1-based plan step: the failing node's, or for a node outside every
+    /// step (a plan-level monitor), the step that was running.
     pub step: Option<usize>,
     pub action: Option<String>,
     pub reason: String,
@@ -322,7 +325,10 @@ pub struct Engine<'w> {
     /// Some fault is pending or in effect: leaves consult the faults.
     pub(crate) faults_live: bool,
     pub(crate) controller: Option<Controller>,
+    pub(crate) handlers: Vec<crate::handler::ActionHandler<'w>>,
     pub(crate) record_slots: [u32; 4],
+    /// The step that started last, while it has not finished.
+    pub(crate) step_running: Option<u32>,
 }
 
 /// A blackboard scope: key to slot.
@@ -374,7 +380,9 @@ impl<'w> Engine<'w> {
             faults: Vec::new(),
             faults_live: false,
             controller: None,
+            handlers: Vec::new(),
             record_slots: [0; 4],
+            step_running: None,
         };
         e.load_steps(doc)?;
         let main = doc.tree(&doc.main).ok_or_else(|| {
@@ -640,18 +648,27 @@ impl<'w> Engine<'w> {
         }
     }
 
-    /// BT.CPP's halt + resetStatus: running descendants are halted, then
-    /// the node goes back to IDLE.
+    /// BT.CPP's `haltChild`: a RUNNING node is halted (its own state
+    /// cleared, its children reset), then the node goes back to IDLE. A
+    /// node that finished only goes back to IDLE: what is below it, and its
+    /// own counters, stay as they are (BT.CPP's `resetStatus`).
     fn reset(&mut self, i: u32) {
         let iu = i as usize;
-        if self.status[iu] == Status::Idle {
-            return;
+        match self.status[iu] {
+            Status::Idle => return,
+            Status::Running => self.halt(i),
+            _ => {}
         }
+        self.set(iu, Status::Idle);
+    }
+
+    /// BT.CPP's `halt()` of a RUNNING node.
+    fn halt(&mut self, i: u32) {
+        let iu = i as usize;
         let def = self.nodes[iu];
-        self.reset_children(def, 0);
         match def.op {
             // BT.CPP v4 keeps the index of a halted SequenceWithMemory.
-            Op::SequenceWithMemory if self.status[iu] == Status::Running => {}
+            Op::SequenceWithMemory => {}
             // A halted action's command still runs; its completion is moot.
             Op::Action(_) if self.cur[iu] == 2 => {
                 if let Some(c) = self.controller.as_mut() {
@@ -662,7 +679,7 @@ impl<'w> Engine<'w> {
             _ => self.cur[iu] = 0,
         }
         self.aux[iu] = 0;
-        self.set(iu, Status::Idle);
+        self.reset_children(def, 0);
     }
 
     fn tick_node(&mut self, i: u32) -> Status {
@@ -701,7 +718,9 @@ impl<'w> Engine<'w> {
                         self.cur[iu] = 0;
                         break Status::Success;
                     }
-                    match self.tick_node(self.kid(def, idx)) {
+                    let c = self.kid(def, idx);
+                    let fresh = self.status[c as usize] == Status::Idle;
+                    match self.tick_node(c) {
                         Status::Running => {
                             self.cur[iu] = idx;
                             break Status::Running;
@@ -712,7 +731,16 @@ impl<'w> Engine<'w> {
                             self.cur[iu] = idx;
                             break Status::Failure;
                         }
-                        _ => idx += 1,
+                        _ => {
+                            idx += 1;
+                            // BT.CPP 4.10: a child that started and finished
+                            // in this tick hands the flow back (RUNNING);
+                            // the next one runs at the next tick.
+                            if fresh && idx < def.len {
+                                self.cur[iu] = idx;
+                                break Status::Running;
+                            }
+                        }
                     }
                 }
             }
@@ -823,11 +851,13 @@ impl<'w> Engine<'w> {
                 } else {
                     (Status::Success, Status::Failure)
                 };
+                let more = |done: u32| n < 0 || (done as i64) < n as i64;
                 loop {
-                    if !(n < 0 || (self.cur[iu] as i64) < n as i64) {
+                    if !more(self.cur[iu]) {
                         self.cur[iu] = 0;
                         break again;
                     }
+                    let fresh = self.status[c as usize] == Status::Idle;
                     let s = self.tick_node(c);
                     if s == Status::Running {
                         break Status::Running;
@@ -838,8 +868,15 @@ impl<'w> Engine<'w> {
                         break end;
                     }
                     self.cur[iu] = self.cur[iu].saturating_add(1);
-                    if n < 0 {
-                        // Forever: one attempt per tick, so a tick ends.
+                    if !more(self.cur[iu]) {
+                        self.cur[iu] = 0;
+                        break again;
+                    }
+                    // BT.CPP 4.10: an attempt that started and ended in this
+                    // tick hands the flow back (RUNNING); the next attempt
+                    // runs at the next tick. After a child that was RUNNING,
+                    // the next attempt starts at once.
+                    if fresh {
                         break Status::Running;
                     }
                 }
@@ -979,6 +1016,7 @@ impl<'w> Engine<'w> {
             if !self.faults.is_empty() {
                 self.faults_on_step(ku, i);
             }
+            self.step_running = Some(k);
             if self.opts.trace {
                 self.trace.push(TraceItem::StepStarted {
                     tick: self.tick,
@@ -1024,6 +1062,9 @@ impl<'w> Engine<'w> {
             if !st.finished {
                 let eff = st.eff_end;
                 self.steps[ku].finished = true;
+                if self.step_running == Some(k) {
+                    self.step_running = None;
+                }
                 if let (Some(e), Some(kb)) = (eff, self.kb.as_mut()) {
                     kb.apply(e);
                 }
@@ -1102,6 +1143,9 @@ impl<'w> Engine<'w> {
     }
 
     fn tick_action(&mut self, i: u32, a: u32) -> Status {
+        if let Some(h) = self.actions[a as usize].handler {
+            return self.tick_handled(i, a, h);
+        }
         let iu = i as usize;
         let started = self.status[iu] == Status::Running && self.cur[iu] != 0;
         if self.faults_live {
@@ -1255,7 +1299,7 @@ impl<'w> Engine<'w> {
     pub(crate) fn record(&mut self, node: u32, r: &Reason) {
         let reason = self.reason_text(r);
         let meta = &self.meta[node as usize];
-        let step = meta.step.map(|s| s as usize);
+        let step = meta.step.or(self.step_running).map(|s| s as usize);
         let faults = self.faults_related(r, &reason);
         let rec = FaultRecord {
             tick: self.tick,
@@ -1524,6 +1568,7 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
                 step: k,
                 start_effect,
                 end_effect,
+                conditions,
             } => {
                 let k32 = u32::try_from(*k).unwrap_or(u32::MAX);
                 while self.e.steps.len() <= *k && self.e.steps.len() < 100_000 {
@@ -1546,7 +1591,11 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
                 if *k >= self.doc.steps.len() && self.e.steps[*k].skipped {
                     self.e.steps[*k].skipped = false;
                     if let Some(nm) = &n.name {
-                        self.derive_step(*k, nm).map_err(|e| e.at_opt(n.at))?;
+                        self.derive_step(*k, nm, conditions.is_none())
+                            .map_err(|e| e.at_opt(n.at))?;
+                    }
+                    if let Some(c) = conditions {
+                        self.given_conditions(*k, c).map_err(|e| e.at_opt(n.at))?;
                     }
                 }
                 let label = format!("`{}`", self.e.steps[*k].label);
@@ -1651,6 +1700,16 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
             let outer = std::mem::replace(&mut self.tree, inst);
             let c = self.node(def, &mut child, my_step, Some(me), depth + 1, calls + 1);
             self.tree = outer;
+            if *autoremap {
+                // BT.CPP creates an autoremapped subtree's new entries in
+                // the parent's blackboard (all but `_private` ones and the
+                // call's own ports): later nodes of the parent see them.
+                for (k, slot) in child {
+                    if !k.starts_with('_') && !ports.iter().any(|(p, _)| *p == k) {
+                        scope.entry(k).or_insert(slot);
+                    }
+                }
+            }
             self.pending.push(c?);
         } else {
             for c in &n.children {
@@ -1665,9 +1724,23 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
         Ok(me)
     }
 
+    /// A step's conditions as its `KbStep` gives them.
+    fn given_conditions(&mut self, k: usize, c: &StepConditions) -> Result<(), LoadError> {
+        let what = format!("`{}`", self.e.steps[k].label);
+        let start = self.e.kb_formula(c.start.as_ref(), &what)?;
+        let over_all = self.e.kb_formula(c.over_all.as_ref(), &what)?;
+        let end = self.e.kb_formula(c.end.as_ref(), &what)?;
+        let st = &mut self.e.steps[k];
+        st.pre_start = start;
+        st.pre_over_all = over_all;
+        st.pre_end = end;
+        Ok(())
+    }
+
     /// A step known only from a tree file (`KbStep name="step 3: (grasp r
-    /// p bin1)"`): its conditions are the domain action's, grounded.
-    fn derive_step(&mut self, k: usize, name: &str) -> Result<(), LoadError> {
+    /// p bin1)"`): its label, and unless the file gives them (`conditions`
+    /// false), its conditions: the domain action's, grounded.
+    fn derive_step(&mut self, k: usize, name: &str, conditions: bool) -> Result<(), LoadError> {
         let Some(open) = name.find('(') else {
             return Ok(());
         };
@@ -1704,6 +1777,10 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
                 .collect::<Vec<_>>()
                 .join(" ")
         );
+        if !conditions {
+            self.e.steps[k].label = label;
+            return Ok(());
+        }
         let what = format!("`{label}`");
         let pre_start = self.e.kb_formula(pre_start.as_ref(), &what)?;
         let over_all = self.e.kb_formula(over_all.as_ref(), &what)?;
@@ -1994,6 +2071,7 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
                 self.e.actions.push(ActionInfo {
                     id: id.into(),
                     ports: range,
+                    handler: None,
                 });
                 Op::Action(a)
             }
@@ -2025,16 +2103,7 @@ mod tests {
     }
 
     fn leaf(id: &str) -> SNode {
-        SNode {
-            kind: Kind::Leaf {
-                id: id.into(),
-                kind: None,
-                ports: Vec::new(),
-            },
-            name: None,
-            children: Vec::new(),
-            at: None,
-        }
+        SNode::leaf(id)
     }
 
     #[test]

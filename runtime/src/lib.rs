@@ -9,10 +9,12 @@
 //! [`Engine::run`] ticks it. A JSON IR carries its world; a BT.CPP XML
 //! tree runs in the world of PDDL files.
 
+pub mod btlog;
 pub mod controller;
 pub mod engine;
 pub mod error;
 pub mod faults;
+pub mod handler;
 pub mod kb;
 pub mod spec;
 pub mod xml;
@@ -21,6 +23,7 @@ pub use controller::{Command, Controller};
 pub use engine::{Engine, FaultRecord, Options, Status, Value};
 pub use error::LoadError;
 pub use faults::{FaultKind, FaultOutcome, Scenario};
+pub use handler::{ActionCall, ActionHandler};
 pub use kb::Kb;
 pub use spec::TreeDoc;
 

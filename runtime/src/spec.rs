@@ -36,6 +36,10 @@ pub enum Kind {
         step: usize,
         start_effect: Option<btc_pddl::logic::Effect>,
         end_effect: Option<btc_pddl::logic::Effect>,
+        /// The step's conditions as the XML gives them (`start_condition`,
+        /// `over_all_condition`, `end_condition`); `None` when it gives none
+        /// (they are then the domain action's, grounded from the name).
+        conditions: Option<Box<StepConditions>>,
     },
     /// A leaf: built in, a KB node, or a node of the models.
     Leaf {
@@ -43,6 +47,14 @@ pub enum Kind {
         kind: Option<LeafKind>,
         ports: Vec<(String, PortValue)>,
     },
+}
+
+/// A step's ground conditions, by when they are checked.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct StepConditions {
+    pub start: Option<btc_pddl::logic::Formula>,
+    pub over_all: Option<btc_pddl::logic::Formula>,
+    pub end: Option<btc_pddl::logic::Formula>,
 }
 
 /// A decorator's count or duration: written out, or read from a
@@ -54,6 +66,17 @@ pub enum Amount<T> {
     Entry(String),
 }
 
+/// As BT.CPP's `config().input_ports` holds it: the number, or the entry
+/// in braces.
+impl<T: std::fmt::Display> std::fmt::Display for Amount<T> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Amount::Fixed(n) => write!(f, "{n}"),
+            Amount::Entry(key) => write!(f, "{{{key}}}"),
+        }
+    }
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct SNode {
     pub kind: Kind,
@@ -61,6 +84,22 @@ pub struct SNode {
     pub children: Vec<SNode>,
     /// Byte offset of the node in its source file, when it has one.
     pub at: Option<usize>,
+}
+
+impl SNode {
+    /// A leaf without ports, name or source position.
+    pub fn leaf(id: &str) -> SNode {
+        SNode {
+            kind: Kind::Leaf {
+                id: id.into(),
+                kind: None,
+                ports: Vec::new(),
+            },
+            name: None,
+            children: Vec::new(),
+            at: None,
+        }
+    }
 }
 
 /// A whole document: its trees, the leaf models and the plan steps.
@@ -191,6 +230,7 @@ pub fn from_node(n: &Node) -> SNode {
                 step: *step,
                 start_effect: None,
                 end_effect: None,
+                conditions: None,
             },
             None,
             vec![from_node(child)],

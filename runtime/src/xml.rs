@@ -7,7 +7,7 @@
 
 use crate::engine::MAX_DEPTH;
 use crate::error::LoadError;
-use crate::spec::{Amount, Kind, SNode, TreeDoc};
+use crate::spec::{Amount, Kind, SNode, StepConditions, TreeDoc};
 use btc_ir::{LeafKind, NodeModel, PortDirection, PortModel, PortValue};
 use btc_pddl::diagnostic::codes;
 use btc_pddl::logic::decode;
@@ -104,6 +104,17 @@ fn ports(e: &mut Elem, skip: &[&str]) -> Vec<(String, PortValue)> {
         .collect()
 }
 
+/// A `KbStep`'s condition attributes, when it has any.
+fn step_conditions(e: &Elem) -> Result<Option<Box<StepConditions>>, LoadError> {
+    let get = |k: &str| pddl(e, k, decode::formula, "a condition");
+    let c = StepConditions {
+        start: get("start_condition")?,
+        over_all: get("over_all_condition")?,
+        end: get("end_condition")?,
+    };
+    Ok((c != StepConditions::default()).then(|| Box::new(c)))
+}
+
 fn node_of(mut e: Elem) -> Result<SNode, LoadError> {
     let name = e.get("name").map(str::to_owned);
     let kind = match e.name.as_str() {
@@ -166,6 +177,7 @@ fn node_of(mut e: Elem) -> Result<SNode, LoadError> {
                 step: step - 1,
                 start_effect: pddl(&e, "start_effect", decode::effect, "an effect")?,
                 end_effect: pddl(&e, "end_effect", decode::effect, "an effect")?,
+                conditions: step_conditions(&e)?,
             }
         }
         // Groot 1 spelling: <Action ID="MoveTo" .../>.

@@ -43,11 +43,21 @@ pub fn assert_linear<I>(
     let large = make(10 * n);
     // Warm up caches and lazy statics before measuring.
     f(&small);
-    let ts = fastest(|| f(&small));
-    let tl = fastest(|| f(&large));
-    let ratio = tl.as_secs_f64() / ts.as_secs_f64().max(1e-6);
-    assert!(
-        ratio < bound,
-        "{what}: 10x the input took {ratio:.1}x the time ({ts:?} -> {tl:?})"
+    // Quadratic work is over the bound every time; a busy machine (other
+    // test binaries run in parallel) only now and then: measure again
+    // before failing.
+    let mut seen = Vec::new();
+    for _ in 0..3 {
+        let ts = fastest(|| f(&small));
+        let tl = fastest(|| f(&large));
+        let ratio = tl.as_secs_f64() / ts.as_secs_f64().max(1e-6);
+        if ratio < bound {
+            return;
+        }
+        seen.push(format!("{ratio:.1}x ({ts:?} -> {tl:?})"));
+    }
+    panic!(
+        "{what}: 10x the input took, in three measurements, {}",
+        seen.join(", ")
     );
 }

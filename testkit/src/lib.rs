@@ -124,6 +124,152 @@ pub fn tool(program: &str, how: &str) -> bool {
     }
     ok
 }
+/// Where `build-btcpp.sh` looks for the BehaviorTree.CPP source archive
+/// (`BTC_BTCPP_ARCHIVE`, or `../shared/vendor/` beside the repository).
+pub fn btcpp_archive() -> PathBuf {
+    std::env::var_os("BTC_BTCPP_ARCHIVE")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| repo().join("../shared/vendor/BehaviorTree.CPP-4.10.0.tar.gz"))
+}
+
+/// The install prefix of a BehaviorTree.CPP 4.10 build, or `None` after
+/// [`skip`]. `BTC_BTCPP` names an existing install; otherwise
+/// `integrations/btcpp/build-btcpp.sh` builds one from the vendored archive
+/// into `~/.cache/btc/btcpp-<sha256>` (once: later calls find it there).
+/// Needs the archive, cmake and a C++17 compiler.
+pub fn btcpp() -> Option<PathBuf> {
+    static FOUND: OnceLock<Result<PathBuf, String>> = OnceLock::new();
+    let found = FOUND.get_or_init(|| {
+        if let Some(p) = std::env::var_os("BTC_BTCPP") {
+            let p = PathBuf::from(p);
+            return if p.join("include/behaviortree_cpp/bt_factory.h").is_file() {
+                Ok(p)
+            } else {
+                Err(format!(
+                    "BTC_BTCPP={} has no include/behaviortree_cpp/bt_factory.h",
+                    p.display()
+                ))
+            };
+        }
+        let archive = btcpp_archive();
+        if !archive.is_file() {
+            return Err(format!("{} is not there", archive.display()));
+        }
+        if Command::new("cmake").arg("--version").output().is_err() {
+            return Err("cmake is not installed (`apt-get install cmake`)".into());
+        }
+        let script = repo().join("integrations/btcpp/build-btcpp.sh");
+        let out = Command::new("bash")
+            .arg(&script)
+            .arg(&archive)
+            .output()
+            .map_err(|e| format!("{} does not run: {e}", script.display()))?;
+        if !out.status.success() {
+            let err = String::from_utf8_lossy(&out.stderr);
+            let tail: Vec<&str> = err.lines().rev().take(15).collect();
+            return Err(format!(
+                "building it failed:\n{}",
+                tail.into_iter().rev().collect::<Vec<_>>().join("\n")
+            ));
+        }
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        let prefix = stdout.lines().last().unwrap_or("").trim();
+        Ok(PathBuf::from(prefix))
+    });
+    match found {
+        Ok(p) => Some(p.clone()),
+        Err(why) => {
+            skip(
+                "BehaviorTree.CPP 4.10",
+                &format!(
+                    "{why}; `bash integrations/btcpp/build-btcpp.sh` builds it from \
+                     ../shared/vendor, or set BTC_BTCPP to an install prefix"
+                ),
+            );
+            None
+        }
+    }
+}
+
+/// Configures (once) and builds CMake project `source` in `build` (under
+/// `target/`, so later runs rebuild only what changed) against the
+/// BehaviorTree.CPP at `prefix`; `targets` are built. Errors carry the
+/// compiler's output.
+pub fn cmake_build(
+    source: &Path,
+    build: &Path,
+    prefix: &Path,
+    defines: &[(&str, &str)],
+    targets: &[&str],
+) -> Result<(), String> {
+    let run = |cmd: &mut Command| -> Result<(), String> {
+        let out = cmd
+            .output()
+            .map_err(|e| format!("cmake does not run: {e}"))?;
+        if out.status.success() {
+            Ok(())
+        } else {
+            Err(format!(
+                "{:?} failed:\n{}{}",
+                cmd,
+                String::from_utf8_lossy(&out.stdout),
+                String::from_utf8_lossy(&out.stderr)
+            ))
+        }
+    };
+    let mut configure = Command::new("cmake");
+    configure
+        .arg("-S")
+        .arg(source)
+        .arg("-B")
+        .arg(build)
+        .arg("-DCMAKE_BUILD_TYPE=Release")
+        .arg(format!("-DCMAKE_PREFIX_PATH={}", prefix.display()));
+    for (k, v) in defines {
+        configure.arg(format!("-D{k}={v}"));
+    }
+    run(&mut configure)?;
+    let jobs = std::env::var("BTC_BUILD_JOBS").unwrap_or_else(|_| "2".into());
+    let mut make = Command::new("cmake");
+    make.arg("--build").arg(build).arg("-j").arg(jobs);
+    for t in targets {
+        make.arg("--target").arg(t);
+    }
+    run(&mut make)
+}
+
+/// The build folder of btc's C++ test harnesses
+/// (`integrations/btcpp/harness/`: `btc_conformance`, `btc_kb_eval`), built
+/// once per test process against [`btcpp`]; `None` after [`skip`]. A build
+/// that fails is a test failure, not a skip.
+pub fn btcpp_harness() -> Option<PathBuf> {
+    static BUILT: OnceLock<Result<PathBuf, String>> = OnceLock::new();
+    let prefix = btcpp()?;
+    let built = BUILT.get_or_init(|| {
+        let build = target_dir("btcpp/harness");
+        cmake_build(
+            &repo().join("integrations/btcpp/harness"),
+            &build,
+            &prefix,
+            &[],
+            &["btc_conformance", "btc_kb_eval"],
+        )
+        .map(|()| build)
+    });
+    match built {
+        Ok(p) => Some(p.clone()),
+        Err(e) => panic!("the C++ test harnesses do not build:\n{e}"),
+    }
+}
+
+/// A folder under the workspace's `target/` for build products of tests.
+pub fn target_dir(name: &str) -> PathBuf {
+    let base = std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| repo().join("target"));
+    base.join(name)
+}
+
 // Inputs shared by the benchmarks.
 
 /// A valid ARIAC plan of exactly `steps` steps: the robot carries the red

@@ -1,0 +1,706 @@
+//! Differential conformance against BehaviorTree.CPP itself: seeded random
+//! trees over every control node and decorator both engines support, with
+//! scripted leaves (a status sequence per leaf, read through ports and
+//! blackboard entries, across SubTree remapping), run tick by tick in btc's
+//! engine and in real BT.CPP 4.10 (`integrations/btcpp/harness/
+//! conformance.cpp`, many trees per process). Every status change of every
+//! node, in order, tick by tick, must be the same in both.
+//!
+//! The one thing compared apart: BT.CPP's `Tree::tickRoot` resets the root
+//! to IDLE after the tick that finishes the tree; btc's engine leaves the
+//! root with its final status (the tree's driver, not a node, makes that
+//! change). `the_tree_driver_resets_the_root_after_the_last_tick` tests it.
+//!
+//! `BTC_CONFORMANCE_CASES` and `BTC_CONFORMANCE_SEED` run other batches.
+
+use btc_runtime::engine::TraceItem;
+use btc_runtime::{xml, Engine, Options, Status};
+use std::collections::HashMap;
+use std::fmt::Write as _;
+use std::path::PathBuf;
+use std::process::Command;
+
+/// One status change: node (preorder), from, to.
+type Change = (u32, char, char);
+
+#[derive(Debug, PartialEq)]
+struct Run {
+    /// Per tick, the changes in order.
+    ticks: Vec<Vec<Change>>,
+    status: char,
+    /// The root's reset after the last tick (BT.CPP's tickRoot).
+    reset: Option<Change>,
+}
+
+fn letter(s: Status) -> char {
+    match s {
+        Status::Idle => 'I',
+        Status::Running => 'R',
+        Status::Success => 'S',
+        Status::Failure => 'F',
+    }
+}
+
+/// A case: its XML, how many ticks at most, simulated or real ms per tick.
+struct Case {
+    xml: String,
+    ticks: u32,
+    tick_ms: u64,
+}
+
+// ---------------------------------------------------------------- btc
+
+fn run_btc(case: &Case) -> Result<Run, String> {
+    run_btc_logged(case).map(|(r, _)| r)
+}
+
+/// [`run_btc`], with the run's `.btlog` as btc writes it.
+fn run_btc_logged(case: &Case) -> Result<(Run, Vec<u8>), String> {
+    let doc = xml::parse(&case.xml).map_err(|e| e.to_string())?;
+    let opts = Options {
+        trace: true,
+        ms_per_tick: case.tick_ms.max(1),
+        ..Options::default()
+    };
+    let mut e = Engine::build(&doc, None, opts).map_err(|e| e.to_string())?;
+    let mut pos: HashMap<u32, usize> = HashMap::new();
+    e.set_action_handler(
+        "Scripted",
+        Box::new(move |c| {
+            let script = c.port("script").map(|v| v.text()).unwrap_or_default();
+            let b = script.as_bytes();
+            if b.is_empty() {
+                return Status::Failure;
+            }
+            let p = pos.entry(c.node).or_insert(0);
+            let ch = b[*p % b.len()];
+            *p += 1;
+            match ch {
+                b'S' => Status::Success,
+                b'R' => Status::Running,
+                _ => Status::Failure,
+            }
+        }),
+    );
+    let mut run = Run {
+        ticks: Vec::new(),
+        status: 'R',
+        reset: None,
+    };
+    let mut seen = 0;
+    let mut last = Status::Running;
+    for _ in 0..case.ticks {
+        let s = e.tick_once();
+        let mut changes = Vec::new();
+        for t in &e.trace[seen..] {
+            if let TraceItem::Status { node, from, to, .. } = t {
+                changes.push((*node, letter(*from), letter(*to)));
+            }
+        }
+        seen = e.trace.len();
+        run.ticks.push(changes);
+        run.status = letter(s);
+        last = s;
+        if s != Status::Running {
+            break;
+        }
+    }
+    let log = btc_runtime::btlog::write(&doc, &e, last, case.tick_ms.max(1), 0)
+        .map_err(|e| e.to_string())?;
+    Ok((run, log))
+}
+
+// ------------------------------------------------------------- BT.CPP
+
+fn harness() -> Option<PathBuf> {
+    btc_testkit::btcpp_harness().map(|d| d.join("btc_conformance"))
+}
+
+fn run_btcpp(exe: &PathBuf, cases: &[Case], name: &str) -> Vec<Result<Run, String>> {
+    run_btcpp_logged(exe, cases, name, None)
+}
+
+/// [`run_btcpp`]; with `btlog`, BT.CPP's FileLogger2 writes `btlog/cI.btlog`.
+fn run_btcpp_logged(
+    exe: &PathBuf,
+    cases: &[Case],
+    name: &str,
+    btlog: Option<&std::path::Path>,
+) -> Vec<Result<Run, String>> {
+    let dir = btc_testkit::target_dir("btcpp/conformance");
+    std::fs::create_dir_all(&dir).unwrap();
+    let input = dir.join(format!("{name}.cases"));
+    let mut text = String::new();
+    for (i, c) in cases.iter().enumerate() {
+        let _ = writeln!(
+            text,
+            "case c{i} {} {}\n{}\nend",
+            c.ticks,
+            c.tick_ms,
+            c.xml.trim()
+        );
+    }
+    std::fs::write(&input, text).unwrap();
+    let mut cmd = Command::new(exe);
+    if let Some(dir) = btlog {
+        std::fs::create_dir_all(dir).unwrap();
+        cmd.arg("--btlog").arg(dir);
+    }
+    let out = cmd.arg(&input).output().unwrap();
+    assert!(
+        out.status.success(),
+        "the harness failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    parse_runs(&String::from_utf8_lossy(&out.stdout), cases.len())
+}
+
+fn parse_change(words: &[&str]) -> Change {
+    let c = |w: &str| w.chars().next().unwrap();
+    (words[0].parse().unwrap(), c(words[1]), c(words[2]))
+}
+
+fn parse_runs(out: &str, n: usize) -> Vec<Result<Run, String>> {
+    let mut runs: Vec<Result<Run, String>> = Vec::with_capacity(n);
+    for line in out.lines() {
+        let words: Vec<&str> = line.split_whitespace().collect();
+        match words.first().copied() {
+            Some("case") => runs.push(Ok(Run {
+                ticks: Vec::new(),
+                status: 'R',
+                reset: None,
+            })),
+            Some("error") => {
+                *runs.last_mut().unwrap() = Err(line[6..].to_owned());
+            }
+            Some("tick") => {
+                if let Some(Ok(r)) = runs.last_mut() {
+                    r.ticks.push(Vec::new());
+                }
+            }
+            Some("status") => {
+                if let Some(Ok(r)) = runs.last_mut() {
+                    r.status = words[1].chars().next().unwrap();
+                }
+            }
+            Some("reset") => {
+                if let Some(Ok(r)) = runs.last_mut() {
+                    r.reset = Some(parse_change(&words[1..]));
+                }
+            }
+            Some(_) => {
+                if let Some(Ok(r)) = runs.last_mut() {
+                    r.ticks.last_mut().unwrap().push(parse_change(&words));
+                }
+            }
+            None => {}
+        }
+    }
+    assert_eq!(runs.len(), n, "the harness answered every case");
+    runs
+}
+
+/// Compares one case; the message says where the runs part.
+fn compare(case: &Case, btc: &Run, cpp: &Run) -> Result<(), String> {
+    let mut b = btc.ticks.clone();
+    let c = cpp.ticks.clone();
+    b.resize(c.len().max(b.len()), Vec::new());
+    for (t, (x, y)) in b.iter().zip(c.iter()).enumerate() {
+        if x != y {
+            return Err(format!(
+                "tick {}: btc {:?}\n        BT.CPP {:?}\n{}",
+                t + 1,
+                x,
+                y,
+                case.xml
+            ));
+        }
+    }
+    if btc.ticks.len() != cpp.ticks.len() || btc.status != cpp.status {
+        return Err(format!(
+            "btc stopped after {} ticks with {}, BT.CPP after {} with {}\n{}",
+            btc.ticks.len(),
+            btc.status,
+            cpp.ticks.len(),
+            cpp.status,
+            case.xml
+        ));
+    }
+    Ok(())
+}
+
+// ---------------------------------------------------------- generator
+
+struct Gen {
+    rng: fastrand::Rng,
+    subtrees: Vec<String>,
+}
+
+const KEYS: &[&str] = &["a", "b", "c"];
+
+impl Gen {
+    fn script(&mut self) -> String {
+        let n = self.rng.usize(1..=4);
+        (0..n)
+            .map(|_| match self.rng.u8(0..20) {
+                0..=8 => 'S',
+                9..=15 => 'F',
+                _ => 'R',
+            })
+            .collect()
+    }
+
+    fn key(&mut self) -> &'static str {
+        KEYS[self.rng.usize(..KEYS.len())]
+    }
+
+    fn leaf(&mut self, out: &mut String, params: &[&str]) {
+        match self.rng.u8(0..100) {
+            0..=44 => {
+                let s = self.script();
+                let _ = write!(out, r#"<Scripted script="{s}"/>"#);
+            }
+            45..=54 => out.push_str("<AlwaysSuccess/>"),
+            55..=62 => out.push_str("<AlwaysFailure/>"),
+            63..=77 => {
+                let k = match params {
+                    [] => self.key(),
+                    ps => ps[self.rng.usize(..ps.len())],
+                };
+                let _ = write!(out, r#"<Scripted script="{{{k}}}"/>"#);
+            }
+            _ => {
+                let s = self.script();
+                let k = self.key();
+                let _ = write!(out, r#"<SetBlackboard value="{s}" output_key="{k}"/>"#);
+            }
+        }
+    }
+
+    fn node(&mut self, out: &mut String, depth: u32, params: &[&str]) {
+        let r = self.rng.u8(0..100);
+        if depth >= 5 || (depth > 0 && r < 30) {
+            return self.leaf(out, params);
+        }
+        if r < 40 && !self.subtrees.is_empty() {
+            let id = self.subtrees[self.rng.usize(..self.subtrees.len())].clone();
+            match self.rng.u8(0..3) {
+                0 => {
+                    let k = self.key();
+                    let _ = write!(out, r#"<SubTree ID="{id}" s="{{{k}}}"/>"#);
+                }
+                1 => {
+                    let s = self.script();
+                    let _ = write!(out, r#"<SubTree ID="{id}" s="{s}"/>"#);
+                }
+                _ => {
+                    let s = self.script();
+                    let _ = write!(out, r#"<SubTree ID="{id}" s="{s}" _autoremap="true"/>"#);
+                }
+            }
+            return;
+        }
+        if r < 75 {
+            let n = self.rng.usize(1..=4);
+            let (tag, extra) = match self.rng.u8(0..6) {
+                0 => ("Sequence", String::new()),
+                1 => ("ReactiveSequence", String::new()),
+                2 => ("SequenceWithMemory", String::new()),
+                3 => ("Fallback", String::new()),
+                4 => ("ReactiveFallback", String::new()),
+                _ => {
+                    let mut t = |name: &str| -> String {
+                        match self.rng.u8(0..4) {
+                            0 => String::new(),
+                            1 => format!(r#" {name}="-1""#),
+                            _ => format!(r#" {name}="{}""#, self.rng.usize(1..=n)),
+                        }
+                    };
+                    let s = t("success_count");
+                    let f = t("failure_count");
+                    ("Parallel", s + &f)
+                }
+            };
+            let _ = write!(out, "<{tag}{extra}>");
+            for _ in 0..n {
+                self.node(out, depth + 1, params);
+            }
+            let _ = write!(out, "</{tag}>");
+            return;
+        }
+        let (tag, extra) = match self.rng.u8(0..7) {
+            0 => ("Inverter", String::new()),
+            1 => ("ForceSuccess", String::new()),
+            2 => ("ForceFailure", String::new()),
+            3 => ("KeepRunningUntilFailure", String::new()),
+            4 => (
+                "RetryUntilSuccessful",
+                format!(r#" num_attempts="{}""#, self.count()),
+            ),
+            5 => ("Repeat", format!(r#" num_cycles="{}""#, self.count())),
+            // Never fires within a case: the clocks are compared apart.
+            _ => (
+                "Timeout",
+                format!(r#" msec="{}""#, if self.rng.bool() { 0 } else { 3_600_000 }),
+            ),
+        };
+        let _ = write!(out, "<{tag}{extra}>");
+        self.node(out, depth + 1, params);
+        let _ = write!(out, "</{tag}>");
+    }
+
+    fn count(&mut self) -> i32 {
+        match self.rng.u8(0..6) {
+            0 => -1,
+            1 => 0,
+            _ => self.rng.i32(1..=4),
+        }
+    }
+
+    fn tree(&mut self) -> String {
+        self.subtrees.clear();
+        let mut defs = String::new();
+        for i in 0..self.rng.usize(0..=2) {
+            let id = format!("S{i}");
+            let _ = write!(defs, r#"<BehaviorTree ID="{id}">"#);
+            self.node(&mut defs, 1, &["s"]);
+            defs.push_str("</BehaviorTree>");
+            self.subtrees.push(id);
+        }
+        let mut main = String::from(r#"<BehaviorTree ID="Main">"#);
+        self.node(&mut main, 0, &[]);
+        main.push_str("</BehaviorTree>");
+        format!(
+            r#"<root BTCPP_format="4" main_tree_to_execute="Main">{main}{defs}<TreeNodesModel><Action ID="Scripted"><input_port name="script" type="std::string"/></Action></TreeNodesModel></root>"#
+        )
+    }
+}
+
+fn env_or(name: &str, default: u64) -> u64 {
+    std::env::var(name)
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(default)
+}
+
+fn check_all(cases: &[Case], name: &str) -> usize {
+    let Some(exe) = harness() else { return 0 };
+    let cpp = run_btcpp(&exe, cases, name);
+    let mut failures = Vec::new();
+    let mut finished = 0;
+    for (i, (case, cpp)) in cases.iter().zip(&cpp).enumerate() {
+        let cpp = match cpp {
+            Ok(r) => r,
+            Err(e) => {
+                failures.push(format!("case {i}: BT.CPP refused it: {e}\n{}", case.xml));
+                continue;
+            }
+        };
+        let btc = match run_btc(case) {
+            Ok(r) => r,
+            Err(e) => {
+                failures.push(format!("case {i}: btc refused it: {e}\n{}", case.xml));
+                continue;
+            }
+        };
+        if cpp.status != 'R' {
+            finished += 1;
+        }
+        if let Err(e) = compare(case, &btc, cpp) {
+            failures.push(format!("case {i}: {e}"));
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "{} of {} cases differ; the first:\n{}",
+        failures.len(),
+        cases.len(),
+        failures
+            .iter()
+            .take(3)
+            .cloned()
+            .collect::<Vec<_>>()
+            .join("\n\n")
+    );
+    finished
+}
+
+#[test]
+fn random_trees_run_tick_for_tick_as_in_btcpp() {
+    let n = env_or("BTC_CONFORMANCE_CASES", 10_000) as usize;
+    let seed = env_or("BTC_CONFORMANCE_SEED", 0x6274_6370_7034);
+    let mut g = Gen {
+        rng: fastrand::Rng::with_seed(seed),
+        subtrees: Vec::new(),
+    };
+    let cases: Vec<Case> = (0..n)
+        .map(|_| Case {
+            xml: g.tree(),
+            ticks: 12,
+            // No Timeout of these trees fires (0 or an hour), so no clock:
+            // the harness ticks without sleeping.
+            tick_ms: 0,
+        })
+        .collect();
+    let finished = check_all(&cases, "random");
+    if harness().is_some() {
+        // The batch is not trivial: most trees finish, some run on.
+        assert!(
+            finished > n / 3 && finished < n,
+            "{finished} of {n} finished"
+        );
+    }
+}
+
+fn one(xml_body: &str, ticks: u32, tick_ms: u64) -> Case {
+    Case {
+        xml: format!(
+            r#"<root BTCPP_format="4" main_tree_to_execute="Main"><BehaviorTree ID="Main">{xml_body}</BehaviorTree><TreeNodesModel><Action ID="Scripted"><input_port name="script" type="std::string"/></Action></TreeNodesModel></root>"#
+        ),
+        ticks,
+        tick_ms,
+    }
+}
+
+#[test]
+fn reactive_nodes_let_two_children_run_in_turn_as_btcpp_4_10_does() {
+    // BT.CPP 4.10 no longer throws here by default (throw_if_multiple_running
+    // is false): both engines halt the other child and go on.
+    check_all(
+        &[
+            one(
+                r#"<ReactiveSequence><Scripted script="RS"/><Scripted script="R"/></ReactiveSequence>"#,
+                8,
+                10,
+            ),
+            one(
+                r#"<ReactiveFallback><Scripted script="RF"/><Scripted script="RRS"/></ReactiveFallback>"#,
+                8,
+                10,
+            ),
+        ],
+        "reactive",
+    );
+}
+
+#[test]
+fn retry_and_repeat_forever_make_one_attempt_per_tick_as_btcpp_does() {
+    // A child that finishes at once is tried again at the next tick (BT.CPP
+    // returns RUNNING and signals a wake-up); one that ran and then failed
+    // is tried again in the same tick.
+    check_all(
+        &[
+            one(
+                r#"<RetryUntilSuccessful num_attempts="-1"><Scripted script="FFFS"/></RetryUntilSuccessful>"#,
+                8,
+                10,
+            ),
+            one(
+                r#"<Repeat num_cycles="-1"><Scripted script="SSF"/></Repeat>"#,
+                8,
+                10,
+            ),
+            one(
+                r#"<RetryUntilSuccessful num_attempts="3"><Scripted script="RFRFFS"/></RetryUntilSuccessful>"#,
+                8,
+                10,
+            ),
+            one(
+                r#"<Repeat num_cycles="3"><Scripted script="RSS"/></Repeat>"#,
+                8,
+                10,
+            ),
+        ],
+        "forever",
+    );
+}
+
+#[test]
+fn timeout_and_sleep_agree_when_the_clocks_agree() {
+    // BT.CPP's Timeout and Sleep use the wall clock (a timer thread); btc's
+    // use simulated time (`ms_per_tick`). With the harness sleeping 100 ms
+    // between ticks and btc counting 100 ms per tick, a 30 ms timeout fires
+    // and a 30 ms sleep ends at the same tick in both.
+    check_all(
+        &[
+            one(
+                r#"<Timeout msec="30"><Scripted script="R"/></Timeout>"#,
+                5,
+                100,
+            ),
+            one(
+                r#"<Sequence><Sleep msec="30"/><Scripted script="S"/></Sequence>"#,
+                5,
+                100,
+            ),
+            one(
+                r#"<Timeout msec="250"><Sequence><Sleep msec="30"/><Scripted script="RRRRS"/></Sequence></Timeout>"#,
+                8,
+                100,
+            ),
+        ],
+        "clock",
+    );
+}
+
+#[test]
+fn the_tree_driver_resets_the_root_after_the_last_tick() {
+    let Some(exe) = harness() else { return };
+    let cases = [
+        one(r#"<Scripted script="RS"/>"#, 5, 10),
+        one(r#"<Sequence><Scripted script="F"/></Sequence>"#, 5, 10),
+        one(r#"<Scripted script="R"/>"#, 3, 10),
+    ];
+    let cpp = run_btcpp(&exe, &cases, "reset");
+    for (case, cpp) in cases.iter().zip(&cpp) {
+        let cpp = cpp.as_ref().unwrap();
+        let btc = run_btc(case).unwrap();
+        compare(case, &btc, cpp).unwrap();
+        if cpp.status == 'R' {
+            assert_eq!(cpp.reset, None, "a tree still running is not reset");
+        } else {
+            // BT.CPP's tickRoot puts the root back to IDLE; btc's root keeps
+            // the final status, which `btc run` reports.
+            assert_eq!(cpp.reset, Some((0, cpp.status, 'I')));
+        }
+    }
+}
+
+// ------------------------------------------------------------ .btlog
+
+/// An XML element with its attributes as a set (BT.CPP keeps ports in a
+/// hash map, so their order means nothing) and, for port lists, its
+/// children as a set too.
+#[derive(Debug, PartialEq, Eq, PartialOrd, Ord, Clone)]
+struct El {
+    name: String,
+    attrs: std::collections::BTreeMap<String, String>,
+    text: String,
+    children: Vec<El>,
+}
+
+fn parse_xml(text: &str) -> El {
+    use quick_xml::events::Event;
+    let mut r = quick_xml::Reader::from_str(text);
+    r.config_mut().trim_text(true);
+    let decoder = r.decoder();
+    let el = |e: &quick_xml::events::BytesStart| El {
+        name: String::from_utf8_lossy(e.name().as_ref()).into_owned(),
+        attrs: e
+            .attributes()
+            .map(|a| {
+                let a = a.unwrap();
+                (
+                    String::from_utf8_lossy(a.key.as_ref()).into_owned(),
+                    a.decode_and_unescape_value(decoder).unwrap().into_owned(),
+                )
+            })
+            .collect(),
+        text: String::new(),
+        children: Vec::new(),
+    };
+    let mut stack: Vec<El> = vec![El {
+        name: String::new(),
+        attrs: Default::default(),
+        text: String::new(),
+        children: Vec::new(),
+    }];
+    loop {
+        match r.read_event().unwrap() {
+            Event::Start(e) => stack.push(el(&e)),
+            Event::Empty(e) => stack.last_mut().unwrap().children.push(el(&e)),
+            Event::Text(t) => {
+                let d = t.decode().unwrap();
+                stack.last_mut().unwrap().text =
+                    quick_xml::escape::unescape(&d).unwrap().into_owned();
+            }
+            Event::End(_) => {
+                let done = stack.pop().unwrap();
+                stack.last_mut().unwrap().children.push(done);
+            }
+            Event::Eof => break,
+            _ => {}
+        }
+    }
+    let mut doc = stack.pop().unwrap();
+    let mut root = doc.children.remove(0);
+    for c in &mut root.children {
+        if c.name == "TreeNodesModel" {
+            for m in &mut c.children {
+                m.children.sort();
+            }
+        }
+    }
+    root
+}
+
+/// A `.btlog` read back: its XML and its (uid, status) records, with the
+/// timestamps checked to never go back.
+fn read_btlog(b: &[u8]) -> (El, Vec<(u16, u8)>) {
+    assert_eq!(&b[..18], b"BTCPP4-FileLogger2");
+    assert_eq!(b[18], 1, "protocol");
+    let n = i32::from_le_bytes(b[19..23].try_into().unwrap()) as usize;
+    let xml = parse_xml(std::str::from_utf8(&b[23..23 + n]).unwrap());
+    let records = &b[23 + n + 8..];
+    assert_eq!(records.len() % 9, 0);
+    let mut last = 0u64;
+    let mut out = Vec::new();
+    for r in records.chunks(9) {
+        let mut t = [0u8; 8];
+        t[..6].copy_from_slice(&r[..6]);
+        let t = u64::from_le_bytes(t);
+        assert!(t >= last, "timestamps go back");
+        last = t;
+        out.push((u16::from_le_bytes([r[6], r[7]]), r[8]));
+    }
+    (xml, out)
+}
+
+#[test]
+fn btc_run_btlog_has_the_structure_btcpp_filelogger2_writes() {
+    let Some(exe) = harness() else { return };
+    let mut g = Gen {
+        rng: fastrand::Rng::with_seed(0x0062_746c_6f67),
+        subtrees: Vec::new(),
+    };
+    let cases: Vec<Case> = (0..300)
+        .map(|_| Case {
+            xml: g.tree(),
+            ticks: 12,
+            tick_ms: 0,
+        })
+        .collect();
+    let dir = btc_testkit::target_dir("btcpp/conformance/btlog");
+    let _ = std::fs::remove_dir_all(&dir);
+    let cpp = run_btcpp_logged(&exe, &cases, "btlog", Some(&dir));
+    let mut records = 0;
+    for (i, (case, cpp)) in cases.iter().zip(&cpp).enumerate() {
+        assert!(cpp.is_ok(), "case {i}: {cpp:?}");
+        let (_, mine) = run_btc_logged(case).unwrap();
+        let theirs = std::fs::read(dir.join(format!("c{i}.btlog"))).unwrap();
+        let (x_mine, r_mine) = read_btlog(&mine);
+        let (x_theirs, r_theirs) = read_btlog(&theirs);
+        assert_eq!(x_mine, x_theirs, "case {i}: the XML differs\n{}", case.xml);
+        assert_eq!(
+            r_mine, r_theirs,
+            "case {i}: the transitions differ\n{}",
+            case.xml
+        );
+        records += r_mine.len();
+    }
+    assert!(records > 10 * cases.len(), "{records} transitions compared");
+}
+
+#[test]
+fn the_builtin_models_btc_writes_are_btcpp_4_10s() {
+    let Some(exe) = harness() else { return };
+    let out = Command::new(exe).arg("--builtins").output().unwrap();
+    assert!(out.status.success());
+    let theirs = String::from_utf8(out.stdout).unwrap();
+    let mine = include_str!("../src/btcpp_builtins.xml");
+    assert_eq!(
+        parse_xml(mine),
+        parse_xml(&theirs),
+        "runtime/src/btcpp_builtins.xml is not what BT.CPP writes: regenerate it with `btc_conformance --builtins`"
+    );
+}
