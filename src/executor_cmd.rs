@@ -74,7 +74,12 @@ fn stale_classes(update: &executor::UserUpdate, existing: &str) -> Vec<Diagnosti
 pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
     let mut database = Database::new();
     let mut diags = Vec::new();
-    let file = rules_cmd::load_rules(&mut database, a.rules, &mut diags)?;
+    let file = rules_cmd::load_rules(&mut database, a.rules)?;
+    diags.extend(
+        btc_lang::project::report::read_diagnostics(&database, file)
+            .iter()
+            .cloned(),
+    );
     diags.extend(db::rules_diagnostics(&database, file).iter().cloned());
     let nodes: Vec<_> = declared_nodes(&database, file)
         .into_iter()

@@ -1,11 +1,14 @@
-//! Reading input files into [`Sources`], with encoding problems reported as
-//! diagnostics rather than failures, and writing outputs. Every command's
-//! files go through here, and through `btc_files` underneath: one bounded
-//! reader, one writer.
+//! Reading input files, with encoding problems reported as diagnostics
+//! rather than failures (into [`Sources`] for the PDDL commands, and as the
+//! project loader's disk, [`Disk`], for rules files and what they name),
+//! and writing outputs. Every command's files go through here, and through
+//! `btc_files` underneath: one bounded reader, one writer.
 
+use btc_lang::project::report::decode_diagnostic;
+use btc_lang::project::{FileLoader, Loaded, ReadFailure};
 use btc_pddl::diagnostic::{codes, Diagnostic};
-use btc_pddl::source::{decode, DecodeProblem, FileId, Sources, Span, MAX_FILE_BYTES};
-use std::path::Path;
+use btc_pddl::source::{decode, DecodeProblem, FileId, Sources, MAX_FILE_BYTES};
+use std::path::{Path, PathBuf};
 
 /// A file's text as read from disk, and what was wrong with it.
 struct Read {
@@ -15,7 +18,7 @@ struct Read {
 }
 
 /// Reads and decodes a file. `Err` only when it cannot be read at all.
-fn read(path: &Path) -> anyhow::Result<Read> {
+fn read(path: &Path) -> Result<Read, btc_files::ReadError> {
     match btc_files::read(path, MAX_FILE_BYTES) {
         Ok(bytes) => {
             let (text, problem) = decode_owned(bytes);
@@ -27,17 +30,17 @@ fn read(path: &Path) -> anyhow::Result<Read> {
                 bytes: known.map_or(MAX_FILE_BYTES + 1, |n| n as usize),
             }),
         }),
-        Err(e @ btc_files::ReadError::NotAFile { .. }) => Err(anyhow::anyhow!(
-            "[{}] cannot read `{}`: {e}",
-            codes::FILE_NOT_REGULAR.id,
-            path.display()
-        )),
-        Err(btc_files::ReadError::Io(e)) => Err(anyhow::anyhow!(
-            "[{}] cannot read `{}`: {e}",
-            codes::FILE_UNREADABLE.id,
-            path.display()
-        )),
+        Err(e) => Err(e),
     }
+}
+
+/// The command stops on a file it was given that cannot be read (exit 2).
+fn unreadable(path: &Path, e: &btc_files::ReadError) -> anyhow::Error {
+    let code = match e {
+        btc_files::ReadError::NotAFile { .. } => codes::FILE_NOT_REGULAR,
+        _ => codes::FILE_UNREADABLE,
+    };
+    anyhow::anyhow!("[{}] cannot read `{}`: {e}", code.id, path.display())
 }
 
 /// Reads a UTF-8 file whole through the bounded reader, for readers that
@@ -76,37 +79,62 @@ fn decode_owned(bytes: Vec<u8>) -> (String, Option<DecodeProblem>) {
     }
 }
 
-/// Reads a file into the database (under its normalized path), reporting
-/// encoding problems as diagnostics. `Err` only when it cannot be read.
-pub fn load_into_db(
-    db: &mut btc_lang::db::Database,
-    path: &Path,
-    diags: &mut Vec<Diagnostic>,
-) -> anyhow::Result<btc_lang::db::SourceFile> {
-    let r = read(path)?;
-    let f = db.set_file(&btc_lang::db::normalize(path), r.text);
-    if let Some(p) = r.problem {
-        diags.push(decode_diagnostic(btc_lang::db::file_id(db, f), p));
+/// The disk as the project loader sees it: every file a rules file names
+/// is read through [`read`].
+pub struct Disk;
+
+impl FileLoader for Disk {
+    fn read(&self, path: &Path) -> Result<Loaded, ReadFailure> {
+        match read(path) {
+            Ok(r) => Ok(Loaded {
+                text: r.text,
+                decode: r.problem,
+            }),
+            Err(e) => Err(failure(e)),
+        }
     }
-    Ok(f)
+
+    fn list(&self, dir: &Path) -> Vec<PathBuf> {
+        list(dir)
+    }
 }
 
-fn decode_diagnostic(id: FileId, problem: DecodeProblem) -> Diagnostic {
-    match problem {
-        DecodeProblem::InvalidUtf8 { offset, byte } => Diagnostic::error(
-            codes::FILE_ENCODING,
-            Span::new(id, offset, offset + 3),
-            format!("this file is not UTF-8: byte 0x{byte:02X} at offset {offset} is not valid"),
-        )
-        .with_hint("save the file as UTF-8; btc read the rest with the bad bytes replaced"),
-        DecodeProblem::BadUtf16 => Diagnostic::error(
-            codes::FILE_ENCODING,
-            Span::new(id, 0, 0),
-            "this file starts with a UTF-16 byte-order mark but is not valid UTF-16",
-        )
-        .with_hint("save the file as UTF-8"),
-        DecodeProblem::TooLarge { bytes } => too_large(id, bytes as u64),
+/// A reader's error as the project loader records it.
+pub fn failure(e: btc_files::ReadError) -> ReadFailure {
+    match e {
+        btc_files::ReadError::Io(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            ReadFailure::NotFound
+        }
+        e @ btc_files::ReadError::NotAFile { .. } => ReadFailure::NotAFile {
+            reason: e.to_string(),
+        },
+        e => ReadFailure::Unreadable {
+            reason: e.to_string(),
+        },
     }
+}
+
+/// The regular files directly in a folder, sorted.
+pub fn list(dir: &Path) -> Vec<PathBuf> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Vec::new();
+    };
+    let mut out: Vec<PathBuf> = entries
+        .filter_map(Result::ok)
+        .filter(|e| e.file_type().is_ok_and(|t| t.is_file()))
+        .map(|e| dir.join(e.file_name()))
+        .collect();
+    out.sort();
+    out
+}
+
+/// A file the user named that cannot be read: the command stops (exit 2).
+pub fn unreadable_job_file(e: btc_lang::project::job::Unreadable) -> anyhow::Error {
+    let code = match e.why {
+        ReadFailure::NotAFile { .. } => codes::FILE_NOT_REGULAR,
+        _ => codes::FILE_UNREADABLE,
+    };
+    anyhow::anyhow!("[{}] {e}", code.id)
 }
 
 /// Writes an output file (`-o`, `fmt`): atomically for a regular file,
@@ -133,20 +161,28 @@ pub fn load(
     path: &Path,
     diags: &mut Vec<Diagnostic>,
 ) -> anyhow::Result<FileId> {
-    let r = read(path)?;
+    let r = read(path).map_err(|e| unreadable(path, &e))?;
     let id = sources.add(path.display().to_string(), r.text);
     if let Some(p) = r.problem {
-        diags.push(decode_diagnostic(id, p));
+        diags.push(decode_diagnostic(id, &p));
     }
     Ok(id)
 }
 
-fn too_large(id: FileId, bytes: u64) -> Diagnostic {
-    // A stream that went on past the limit has no known size.
-    let message = if bytes == MAX_FILE_BYTES as u64 + 1 {
-        format!("this input goes on past {MAX_FILE_BYTES} bytes, the most btc reads")
-    } else {
-        format!("this file has {bytes} bytes; btc reads files of at most {MAX_FILE_BYTES} bytes")
-    };
-    Diagnostic::error(codes::FILE_TOO_LARGE, Span::new(id, 0, 0), message)
+/// Reads a file into the database through [`Disk`], with its encoding
+/// problems as diagnostics. `Err` only when it cannot be read at all.
+pub fn load_into_db(
+    db: &mut btc_lang::db::Database,
+    path: &Path,
+    diags: &mut Vec<Diagnostic>,
+) -> anyhow::Result<btc_lang::db::SourceFile> {
+    let at = btc_lang::path::FilePath::new(path);
+    let f = btc_lang::project::read_file(db, &Disk, &at)
+        .map_err(|why| unreadable_job_file(btc_lang::project::job::Unreadable { path: at, why }))?;
+    diags.extend(
+        btc_lang::project::report::read_diagnostics(db, f)
+            .iter()
+            .cloned(),
+    );
+    Ok(f)
 }

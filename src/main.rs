@@ -74,7 +74,9 @@ enum Command {
         /// The plan to compile.
         #[arg(long)]
         plan: PathBuf,
-        /// The PDDL problem the plan solves (default: the rules file's `problem`).
+        /// The PDDL problem the plan solves (default: `STEM.pddl` beside the
+        /// plan `STEM.EXT`, else the rules file's `problem`, else
+        /// `problem.pddl` beside the plan or the rules file).
         #[arg(long)]
         problem: Option<PathBuf>,
         /// The PDDL domain (default: the rules file's `domain`).
@@ -96,6 +98,10 @@ enum Command {
         /// (`btc_runtime.py`, written beside an `-o` output).
         #[arg(long, value_enum, default_value_t = RuntimeArg::Inline)]
         runtime: RuntimeArg,
+        /// Compile a plan that does not replay on its problem (a step whose
+        /// precondition fails, a goal not reached), with warnings.
+        #[arg(long)]
+        allow_invalid_plan: bool,
         /// How to print diagnostics.
         #[arg(long, value_enum, default_value_t)]
         format: Format,
@@ -297,6 +303,7 @@ fn main() -> ExitCode {
             inline,
             node_module,
             runtime,
+            allow_invalid_plan,
             format,
         } => rules_cmd::compile(&rules_cmd::CompileArgs {
             rules,
@@ -310,6 +317,7 @@ fn main() -> ExitCode {
                 node_module,
                 runtime: runtime.into(),
             },
+            allow_invalid_plan,
             format,
         }),
         Command::Executor {

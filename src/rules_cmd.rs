@@ -1,79 +1,56 @@
 //! `btc check` and `btc compile`: rules files, through the incremental
-//! database.
+//! database and the project loader (the same one the language server uses).
 
 use crate::{files, report, Format};
 use btc_emit as emit;
-use btc_lang::db::{self, CompileJob, Database, SourceFile};
-use btc_lang::rules::{ImportTarget, Item};
+use btc_lang::db::{self, Database, SourceFile};
+use btc_lang::path::FilePath;
+use btc_lang::project::{self, JobPaths, LoadedJob, PlanSource};
 use btc_lang::targets;
-use btc_pddl::diagnostic::{has_errors, Diagnostic};
+use btc_pddl::diagnostic::{has_errors, Diagnostic, Severity};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-/// Loads a rules file and everything it names (domain, problem, imports),
-/// transitively, from disk into the database.
-pub fn load_rules(
-    db: &mut Database,
-    path: &Path,
-    diags: &mut Vec<Diagnostic>,
-) -> anyhow::Result<SourceFile> {
-    let root = files::load_into_db(db, path, diags)?;
-    let mut pending = vec![path.to_path_buf()];
-    let mut seen = std::collections::BTreeSet::new();
-    while let Some(p) = pending.pop() {
-        if !seen.insert(db::normalize(&p)) {
-            continue;
-        }
-        let Some(f) = db.file(&db::normalize(&p)) else {
-            continue;
-        };
-        let dir = p.parent().map(Path::to_path_buf).unwrap_or_default();
-        let mut named: Vec<(String, bool)> = Vec::new(); // (path, is rules)
-        for n in &db::parsed_rules(db, f).items {
-            match &n.item {
-                Item::Domain { path, .. } | Item::Problem { path, .. } => {
-                    named.extend(path.plain().map(|s| (s, false)))
-                }
-                Item::Import {
-                    target: ImportTarget::Path { path },
-                    ..
-                } => named.extend(path.plain().map(|s| (s, true))),
-                _ => {}
-            }
-        }
-        for (written, is_rules) in named {
-            let full = dir.join(&written);
-            if db.file(&db::normalize(&full)).is_none() && full.is_file() {
-                // Unreadable files are reported by the checker as not found.
-                let _ = files::load_into_db(db, &full, diags);
-            }
-            if is_rules {
-                pending.push(full);
-            }
-        }
-    }
-    Ok(root)
+/// Loads a rules file and everything it names from disk.
+pub fn load_rules(db: &mut Database, path: &Path) -> anyhow::Result<SourceFile> {
+    project::load_rules(db, &files::Disk, &FilePath::new(path)).map_err(|why| {
+        files::unreadable_job_file(project::job::Unreadable {
+            path: FilePath::new(path),
+            why,
+        })
+    })
 }
 
-/// `btc check RULES`: the rules file, its imports and its PDDL files. Object
-/// names are checked when the rules file names a `problem`.
+/// `domain.pddl` and `problem.pddl (named by the rules file)` for the
+/// summaries; `None` when there is none.
+fn shown(db: &Database, f: Option<SourceFile>, how: Option<project::ProblemChoice>) -> String {
+    match (f, how) {
+        (Some(f), Some(how)) => format!("{} ({how})", f.path(db)),
+        (Some(f), None) => f.path(db).to_string(),
+        (None, _) => "none".to_owned(),
+    }
+}
+
+/// `btc check RULES`: the rules file, its imports, the domain and the
+/// problem it names, with every file's diagnostics.
 pub fn check(path: &Path, format: Format) -> anyhow::Result<ExitCode> {
     let mut database = Database::new();
-    let mut diags = Vec::new();
-    let rules = load_rules(&mut database, path, &mut diags)?;
-    diags.extend(db::rules_diagnostics(&database, rules).iter().cloned());
-    if let Some(d) = db::domain_file(&database, rules) {
-        diags.extend(db::checked_domain(&database, d).diagnostics.iter().cloned());
-    }
+    let rules = load_rules(&mut database, path)?;
+    let diags = project::flatten(project::project_report(&database, rules));
+    let domain = db::domain_file(&database, rules);
+    let problem = db::problem_file(&database, rules);
     let sources = database.sources();
     let json = report::diagnostics(&diags, &sources, format);
     let (e, w) = report::count(&diags);
     match format {
         Format::Json => println!(
             "{}",
-            serde_json::to_string_pretty(
-                &serde_json::json!({ "ok": e == 0, "diagnostics": json })
-            )?
+            serde_json::to_string_pretty(&serde_json::json!({
+                "ok": e == 0,
+                "domain": domain.map(|f| f.path(&database).to_string()),
+                "problem": problem.map(|f| f.path(&database).to_string()),
+                "diagnostics": json
+            }))?
         ),
         Format::Text => {
             let items = db::parsed_rules(&database, rules).items.len();
@@ -84,6 +61,8 @@ pub fn check(path: &Path, format: Format) -> anyhow::Result<ExitCode> {
                 report::plural(e, "error"),
                 report::plural(w, "warning")
             );
+            println!("  domain: {}", shown(&database, domain, None));
+            println!("  problem: {}", shown(&database, problem, None));
         }
     }
     Ok(if e > 0 {
@@ -110,119 +89,121 @@ pub struct CompileArgs {
     pub emit: Output,
     pub output: Option<PathBuf>,
     pub options: emit::Options,
+    pub allow_invalid_plan: bool,
     pub format: Format,
 }
 
-/// Loads a rules file, a plan, and the problem and domain (given, named by
-/// the rules file, or `problem.pddl` beside the plan or the rules) into a
-/// fresh database; file-level problems go to `diags`.
+/// A compile job loaded from disk, with what it reports before lowering.
+pub struct Job {
+    pub db: Database,
+    pub loaded: LoadedJob,
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+impl Job {
+    pub fn job(&self) -> db::CompileJob {
+        self.loaded.job
+    }
+
+    /// `problem.pddl (paired with the plan by name)`, for the summaries.
+    pub fn problem_shown(&self) -> String {
+        let (f, how) = self.loaded.problem.unzip();
+        shown(&self.db, f, how)
+    }
+
+    pub fn problem_path(&self) -> Option<String> {
+        self.loaded
+            .problem
+            .map(|(f, _)| f.path(&self.db).to_string())
+    }
+}
+
+/// Loads a rules file, a plan, and the domain and problem (see
+/// `btc_lang::project::job` for which problem), and collects what the job
+/// reports: every file's diagnostics, then the plan replayed on the problem
+/// (errors that refuse the job, or warnings with `allow_invalid_plan`).
 pub fn load_job(
-    rules_path: &Path,
-    plan_path: &Path,
-    problem_path: Option<&Path>,
-    domain_path: Option<&Path>,
-    diags: &mut Vec<Diagnostic>,
-) -> anyhow::Result<(Database, CompileJob)> {
-    load_job_with(
-        rules_path,
-        PlanInput::File(plan_path),
-        problem_path,
-        domain_path,
-        diags,
-    )
-}
-
-/// Where a job's plan comes from.
-pub enum PlanInput<'a> {
-    /// A plan file on disk.
-    File(&'a Path),
-    /// A plan that does not exist yet (the closed loop plans it): an empty
-    /// file under this name; the plan reader's diagnostics about it (L006,
-    /// no steps) are left out.
-    Planned(&'a str),
-}
-
-pub fn load_job_with(
-    rules_path: &Path,
-    plan_input: PlanInput,
-    problem_path: Option<&Path>,
-    domain_path: Option<&Path>,
-    diags: &mut Vec<Diagnostic>,
-) -> anyhow::Result<(Database, CompileJob)> {
+    rules: &Path,
+    plan: PlanSource,
+    problem: Option<&Path>,
+    domain: Option<&Path>,
+    allow_invalid_plan: bool,
+) -> anyhow::Result<Job> {
     let mut database = Database::new();
-    let rules = load_rules(&mut database, rules_path, diags)?;
-    let (plan, plan_path) = match plan_input {
-        PlanInput::File(p) => (files::load_into_db(&mut database, p, diags)?, Some(p)),
-        PlanInput::Planned(name) => (database.set_file(name, String::new()), None),
+    let planned = matches!(plan, PlanSource::Planned(_));
+    let paths = JobPaths {
+        rules: FilePath::new(rules),
+        plan,
+        problem: problem.map(FilePath::new),
+        domain: domain.map(FilePath::new),
     };
-    let problem_path = problem_path.map(Path::to_path_buf).or_else(|| {
-        if db::declared_path(&database, rules, true).is_some() {
-            return None;
+    let loaded = project::load_job(&mut database, &files::Disk, &paths)
+        .map_err(files::unreadable_job_file)?;
+    let job = loaded.job;
+    let plan_file = db::file_id(&database, job.plan(&database));
+    let mut diagnostics: Vec<Diagnostic> = db::job_diagnostics(&database, job)
+        .iter()
+        // A plan still to be made has no steps yet: nothing to say about it.
+        .filter(|d| !(planned && d.span.file == plan_file && d.code.starts_with('L')))
+        .cloned()
+        .collect();
+    if !planned {
+        for d in project::fit::plan_validation(&database, job) {
+            let mut d = d.clone();
+            if allow_invalid_plan {
+                d.severity = Severity::Warning;
+            }
+            diagnostics.push(d);
         }
-        [plan_path.and_then(Path::parent), rules_path.parent()]
-            .into_iter()
-            .flatten()
-            .map(|d| d.join("problem.pddl"))
-            .find(|p| p.is_file())
-    });
-    let problem = problem_path
-        .as_deref()
-        .map(|p| files::load_into_db(&mut database, p, diags))
-        .transpose()?;
-    let domain = domain_path
-        .map(|p| files::load_into_db(&mut database, p, diags))
-        .transpose()?;
-    let job = CompileJob::new(&database, rules, plan, problem, domain);
-    let planned = plan_path.is_none().then(|| db::file_id(&database, plan));
-    diags.extend(
-        db::job_diagnostics(&database, job)
-            .iter()
-            .filter(|d| Some(d.span.file) != planned || !d.code.starts_with('L'))
-            .cloned(),
-    );
-    Ok((database, job))
+    }
+    Ok(Job {
+        db: database,
+        loaded,
+        diagnostics,
+    })
 }
 
 pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
-    let mut diags = Vec::new();
-    let (database, job) = load_job(
+    let mut job = load_job(
         &a.rules,
-        &a.plan,
+        PlanSource::File(FilePath::new(&a.plan)),
         a.problem.as_deref(),
         a.domain.as_deref(),
-        &mut diags,
+        a.allow_invalid_plan,
     )?;
-    let mut result = if has_errors(&diags) {
+    let mut result = if has_errors(&job.diagnostics) {
         None
     } else {
-        db::compile(&database, job).as_ref().ok()
+        db::compile(&job.db, job.job()).as_ref().ok()
     };
     // What the target cannot express is refused, never approximated.
     if let (Some(ir), Output::Tree(emit::Format::Pytrees)) = (result, a.emit) {
-        let refused = targets::refusals(&database, job, ir, targets::Target::Pytrees);
+        let refused = targets::refusals(&job.db, job.job(), ir, targets::Target::Pytrees);
         if !refused.is_empty() {
-            diags.extend(refused);
+            job.diagnostics.extend(refused);
             result = None;
         }
     }
     if result.is_none() {
-        if let Err(errs) = db::compile(&database, job) {
+        if let Err(errs) = db::compile(&job.db, job.job()) {
             for e in errs {
-                if !diags.contains(e) {
-                    diags.push(e.clone());
+                if !job.diagnostics.contains(e) {
+                    job.diagnostics.push(e.clone());
                 }
             }
         }
     }
-    let sources = database.sources();
-    let json = report::diagnostics(&diags, &sources, a.format);
+    let sources = job.db.sources();
+    let json = report::diagnostics(&job.diagnostics, &sources, a.format);
     let Some(ir) = result else {
         if a.format == Format::Json {
             println!(
                 "{}",
-                serde_json::to_string_pretty(
-                    &serde_json::json!({ "ok": false, "diagnostics": json })
-                )?
+                serde_json::to_string_pretty(&serde_json::json!({
+                    "ok": false,
+                    "problem": job.problem_path(),
+                    "diagnostics": json
+                }))?
             );
         }
         return Ok(ExitCode::from(1));
@@ -239,24 +220,24 @@ pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
             emit::emit(&ir, f, &a.options)
         }
         (_, Output::Tree(f)) => emit::emit(ir, f, &a.options),
-        (_, Output::Kb) => match db::JobWorld::of(&database, job) {
+        (_, Output::Kb) => match db::JobWorld::of(&job.db, job.job()) {
             Some(w) => emit::kb::emit(w.domain, w.dix, w.problem, w.pix),
             None => anyhow::bail!(
                 "`--emit kb` needs the PDDL problem: pass `--problem PROBLEM` or name it in the rules file"
             ),
         },
     };
+    let steps = ir.steps.iter().filter(|s| !s.skipped).count();
+    let what = format!(
+        "{steps} of {} plan steps ({} skipped); problem {}",
+        ir.steps.len(),
+        ir.steps.len() - steps,
+        job.problem_shown()
+    );
     match &a.output {
         Some(out) => {
             files::write_atomically(out, &text)?;
-            let steps = ir.steps.iter().filter(|s| !s.skipped).count();
-            eprintln!(
-                "wrote {} ({} of {} plan steps, {} skipped)",
-                out.display(),
-                report::plural(steps, "step"),
-                ir.steps.len(),
-                ir.steps.len() - steps
-            );
+            eprintln!("wrote {}: {what}", out.display());
             // An imported runtime goes beside the module, where its import
             // finds it; it is btc's file and always rewritten.
             if a.emit == Output::Tree(emit::Format::Pytrees)
@@ -268,7 +249,10 @@ pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
                 eprintln!("wrote {}", rt.display());
             }
         }
-        None => print!("{text}"),
+        None => {
+            print!("{text}");
+            eprintln!("compiled {}: {what}", a.plan.display());
+        }
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -3,6 +3,8 @@
 
 use crate::{files, paths, report, rules_cmd, Format};
 use btc_lang::db;
+use btc_lang::path::FilePath;
+use btc_lang::project::PlanSource;
 use btc_pddl::diagnostic::{codes, has_errors, Diagnostic};
 use btc_pddl::pipeline;
 use btc_pddl::source::{FileId, Sources, Span};
@@ -34,7 +36,8 @@ pub struct RunArgs {
     /// With `--replan`: plans made after failures, at most.
     #[arg(long, default_value_t = 5, requires = "replan")]
     pub max_replans: usize,
-    /// The PDDL problem whose `:init` is the initial KB.
+    /// The PDDL problem whose `:init` is the initial KB (default, with
+    /// RULES: as `btc compile` finds it).
     #[arg(long)]
     pub problem: Option<PathBuf>,
     /// The PDDL domain (default: the rules file's, or `domain.pddl`
@@ -64,6 +67,9 @@ pub struct RunArgs {
     /// Send action leaves' commands through the queued controller thread.
     #[arg(long)]
     pub controller: bool,
+    /// Run a plan that does not replay on its problem (with warnings).
+    #[arg(long, conflicts_with = "tree")]
+    pub allow_invalid_plan: bool,
     #[arg(long, value_enum, default_value_t)]
     pub format: Format,
 }
@@ -128,14 +134,20 @@ pub fn run(a: &RunArgs) -> anyhow::Result<ExitCode> {
 }
 
 fn run_rules(a: &RunArgs, rules: &Path, plan: &Path) -> anyhow::Result<ExitCode> {
-    let mut diags = Vec::new();
-    let (database, job) = rules_cmd::load_job(
+    let loaded = rules_cmd::load_job(
         rules,
-        plan,
+        PlanSource::File(FilePath::new(plan)),
         a.problem.as_deref(),
         a.domain.as_deref(),
-        &mut diags,
+        a.allow_invalid_plan,
     )?;
+    let problem = loaded.problem_shown();
+    let rules_cmd::Job {
+        db: database,
+        loaded,
+        diagnostics: mut diags,
+    } = loaded;
+    let job = loaded.job;
     let ir = if has_errors(&diags) {
         None
     } else {
@@ -162,7 +174,14 @@ fn run_rules(a: &RunArgs, rules: &Path, plan: &Path) -> anyhow::Result<ExitCode>
     let doc = TreeDoc::from_ir(ir);
     let anchor = db::file_id(&database, job.plan(&database));
     let world = world.world().map_err(anyhow::Error::msg)?;
-    execute(a, &doc, Some(Kb::new(&world)), &mut sources, anchor)
+    execute(
+        a,
+        &doc,
+        Some(Kb::new(&world)),
+        &mut sources,
+        anchor,
+        Some(&problem),
+    )
 }
 
 /// A BT.CPP XML tree file and the files it `<include>`s, each read into
@@ -222,7 +241,15 @@ fn run_tree(a: &RunArgs, tree: &Path) -> anyhow::Result<ExitCode> {
                 }
             };
             let doc = TreeDoc::from_ir(&ir);
-            return execute(a, &doc, Some(Kb::new(&world)), &mut sources, file);
+            let shown = format!("{} (carried by the tree file)", ir.problem);
+            return execute(
+                a,
+                &doc,
+                Some(Kb::new(&world)),
+                &mut sources,
+                file,
+                Some(&shown),
+            );
         }
         Loaded::Ir(ir) => (Tree::Ir(ir), None),
         Loaded::IrV1(v1) => {
@@ -244,7 +271,7 @@ fn run_tree(a: &RunArgs, tree: &Path) -> anyhow::Result<ExitCode> {
         .or_else(|| named.as_ref().and_then(|(_, p)| recorded(p)));
     let Some(problem_path) = problem_path else {
         return match (doc, &named) {
-            (Tree::Xml(doc), _) => execute(a, &doc, None, &mut sources, file),
+            (Tree::Xml(doc), _) => execute(a, &doc, None, &mut sources, file, None),
             (_, Some((_, p))) => {
                 let e = LoadError::new(
                     codes::X_WORLD,
@@ -293,7 +320,20 @@ fn run_tree(a: &RunArgs, tree: &Path) -> anyhow::Result<ExitCode> {
             }
         },
     };
-    execute(a, &doc, Some(Kb::new(&world)), &mut sources, file)
+    let how = if a.problem.is_some() {
+        "given"
+    } else {
+        "named by the tree file"
+    };
+    let shown = format!("{} ({how})", problem_path.display());
+    execute(
+        a,
+        &doc,
+        Some(Kb::new(&world)),
+        &mut sources,
+        file,
+        Some(&shown),
+    )
 }
 
 /// A loaded tree still waiting for its world.
@@ -304,12 +344,14 @@ enum Tree {
     V1(btc_ir::json::V1),
 }
 
+/// Runs a tree; `problem` is the problem as the summary names it.
 fn execute(
     a: &RunArgs,
     doc: &TreeDoc,
     kb: Option<Kb<'_>>,
     sources: &mut Sources,
     tree_file: FileId,
+    problem: Option<&str>,
 ) -> anyhow::Result<ExitCode> {
     let opts = Options {
         ticks_per_action: a.ticks_per_action,
@@ -383,15 +425,18 @@ fn execute(
     match a.format {
         Format::Json => {
             let mut v = serde_json::to_value(&summary)?;
-            if let (Some(o), Some(c)) = (v.as_object_mut(), &commands) {
-                o.insert("commands".into(), serde_json::to_value(c)?);
+            if let Some(o) = v.as_object_mut() {
+                if let Some(c) = &commands {
+                    o.insert("commands".into(), serde_json::to_value(c)?);
+                }
+                o.insert("problem".into(), problem.into());
             }
             if let (Some(o), Some(kb)) = (v.as_object_mut(), &engine.kb) {
                 o.insert("kb".into(), serde_json::to_value(kb.snapshot())?);
             }
             println!("{}", serde_json::to_string_pretty(&v)?);
         }
-        Format::Text => print_summary(&summary, commands.as_ref().map(Vec::len)),
+        Format::Text => print_summary(&summary, problem, commands.as_ref().map(Vec::len)),
     }
     Ok(if summary.success() {
         ExitCode::SUCCESS
@@ -400,7 +445,7 @@ fn execute(
     })
 }
 
-fn print_summary(s: &Summary, commands: Option<usize>) {
+fn print_summary(s: &Summary, problem: Option<&str>, commands: Option<usize>) {
     let yes = |b: bool| if b { "yes" } else { "no" };
     println!(
         "{} after {}; {} of {} plan steps done; goal reached: {}",
@@ -413,6 +458,7 @@ fn print_summary(s: &Summary, commands: Option<usize>) {
             None => "no goal (no problem given)",
         }
     );
+    println!("  problem: {}", problem.unwrap_or("none"));
     if let Some(why) = &s.goal_failure {
         println!("  goal: {why}");
     }
@@ -440,18 +486,24 @@ fn run_replan(a: &RunArgs, rules: &Path) -> anyhow::Result<ExitCode> {
     if a.controller {
         anyhow::bail!("`--replan` runs the simulated world only; leave out `--controller`");
     }
-    let mut diags = Vec::new();
     let input = match &a.plan {
-        Some(p) => rules_cmd::PlanInput::File(p),
-        None => rules_cmd::PlanInput::Planned(PLANNED),
+        Some(p) => PlanSource::File(FilePath::new(p)),
+        None => PlanSource::Planned(FilePath::new(PLANNED)),
     };
-    let (mut database, job) = rules_cmd::load_job_with(
+    let loaded = rules_cmd::load_job(
         rules,
         input,
         a.problem.as_deref(),
         a.domain.as_deref(),
-        &mut diags,
+        a.allow_invalid_plan,
     )?;
+    let problem = loaded.problem_shown();
+    let rules_cmd::Job {
+        db: mut database,
+        loaded,
+        diagnostics: mut diags,
+    } = loaded;
+    let job = loaded.job;
     if has_errors(&diags) || btc_lang::db::JobWorld::of(&database, job).is_none() {
         return fail(&diags, &database.sources(), a.format);
     }
@@ -524,13 +576,14 @@ fn run_replan(a: &RunArgs, rules: &Path) -> anyhow::Result<ExitCode> {
             let json = report::diagnostics(&summary.diagnostics, &sources, a.format);
             if let Some(o) = v.as_object_mut() {
                 o.insert("ok".into(), summary.success().into());
+                o.insert("problem".into(), problem.into());
                 o.insert("diagnostics".into(), json.into());
             }
             println!("{}", serde_json::to_string_pretty(&v)?);
         }
         Format::Text => {
             report::diagnostics(&diags, &sources, a.format);
-            print_loop(&summary);
+            print_loop(&summary, &problem);
             report::diagnostics(&summary.diagnostics, &sources, a.format);
         }
     }
@@ -543,7 +596,7 @@ fn run_replan(a: &RunArgs, rules: &Path) -> anyhow::Result<ExitCode> {
 
 /// The loop's text summary (timings are in `--format json` only, so the
 /// text is the same from run to run).
-fn print_loop(s: &btc_agent::LoopSummary) {
+fn print_loop(s: &btc_agent::LoopSummary, problem: &str) {
     for at in &s.attempts {
         let how = if at.source == "given" {
             "the given plan".to_owned()
@@ -627,6 +680,7 @@ fn print_loop(s: &btc_agent::LoopSummary) {
         report::plural(s.attempts.len(), "plan"),
         report::plural(s.replans.len(), "replan"),
     );
+    println!("  problem: {problem}");
     if let Some(why) = &s.goal_failure {
         println!("  goal: {why}");
     }

@@ -218,6 +218,9 @@ fn compile(rules: &str, plan: &str, problem: &str, emit: &str, out: &str, inline
         emit,
         "-o",
         out,
+        // Some plans fail on purpose (a grasp before the move): both
+        // executors must fail them the same way.
+        "--allow-invalid-plan",
     ];
     if inline {
         args.push("--inline");
@@ -249,6 +252,7 @@ fn btc_run(
         problem,
         "--ticks-per-action",
         ticks_per_action,
+        "--allow-invalid-plan",
         "--trace",
         trace.to_str().unwrap(),
         "--format",

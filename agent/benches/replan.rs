@@ -7,7 +7,7 @@
 //!   long-running agent), so salsa re-does only what the plan changes.
 
 use btc_agent::{run_loop, LoopOptions};
-use btc_lang::db::{self, CompileJob, Database};
+use btc_lang::db::{CompileJob, Database};
 use btc_runtime::Scenario;
 use divan::Bencher;
 use std::path::PathBuf;
@@ -58,7 +58,7 @@ fn ariac() -> (Database, CompileJob) {
     let mut db = Database::new();
     let mut load = |name: &str| {
         let p = dir().join(name);
-        db.set_file(&db::normalize(&p), std::fs::read_to_string(&p).unwrap())
+        db.set_file(&p, std::fs::read_to_string(&p).unwrap())
     };
     let rules = load("rules.btrules");
     let domain = load("domain.pddl");

@@ -3,7 +3,7 @@
 //! check the loop's state handling directly.
 
 use btc_agent::{run_loop, LoopOptions};
-use btc_lang::db::{self, CompileJob, Database};
+use btc_lang::db::{CompileJob, Database};
 use btc_runtime::{Scenario, Status};
 use btc_testkit::repo as root;
 
@@ -14,7 +14,7 @@ fn ariac(problem: &str) -> (Database, CompileJob) {
     let mut db = Database::new();
     let mut load = |name: &str| {
         let p = dir.join(name);
-        db.set_file(&db::normalize(&p), std::fs::read_to_string(&p).unwrap())
+        db.set_file(&p, std::fs::read_to_string(&p).unwrap())
     };
     let rules = load("rules.btrules");
     let domain = load("domain.pddl");

@@ -21,7 +21,7 @@ fn run(name: &str) -> btc_agent::sim::TrialReport {
     let c = cell(&mut db);
     let path = repo().join(format!("examples/ariac_cell/trials/{name}.yaml"));
     let text = std::fs::read_to_string(&path).unwrap();
-    let f = db.set_file(&db::normalize(&path), text.clone());
+    let f = db.set_file(&path, text.clone());
     let (t, diags) = trial::read(&text, db::file_id(&db, f));
     assert!(diags.iter().all(|d| !d.is_error()), "{diags:#?}");
     let mut r = Runner::with_db(&c, db).unwrap_or_else(|e| panic!("{e:?}"));

@@ -3,35 +3,43 @@
 //! struct whose tree has item-relative spans, so an edit re-checks only the
 //! items it changed (see the tests at the end).
 
+use crate::path::{AsFilePath, FilePath};
+use crate::project::ReadFailure;
 use crate::rules::actions::ActionIndex;
-use crate::rules::check::{check_item, Decls, DomainCtx};
+use crate::rules::check::{check_item, Decls, DomainCtx, VarTypes};
 use crate::rules::file_checks::{self, Finding, ItemHead, ItemUses, RuleFacts};
 use crate::rules::parse::{parse_item_text, parse_rules_with, shift};
 use crate::rules::{ImportTarget, Item, ItemNode, ParsedRules};
 use btc_pddl::diagnostic::{codes, Diagnostic};
 use btc_pddl::pipeline::{domain_unit_from, problem_unit_from};
-use btc_pddl::source::{FileId, Sources, Span};
+use btc_pddl::source::{DecodeProblem, FileId, Sources, Span};
 use btc_pddl::{ast::Domain, ast::Problem, DomainIndex, ProblemIndex};
 use salsa::plumbing::AsId;
 use salsa::Setter;
 use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex};
 
-/// One file's text. Paths are as the driver gave them (the stdlib's are
-/// `std::NAME`).
+/// One file's text, and what was wrong with its bytes (reported as a
+/// diagnostic of the file; the text is what could be decoded).
 #[salsa::input(debug)]
 pub struct SourceFile {
     #[returns(ref)]
-    pub path: String,
+    pub path: FilePath,
     #[returns(ref)]
     pub text: String,
+    #[returns(ref)]
+    pub decode: Option<DecodeProblem>,
 }
 
-/// Every file the database knows, by path.
+/// Every file the database knows, by path, and the files a loader was
+/// asked for and could not give (so that they are not asked for again
+/// until they change).
 #[salsa::input(debug)]
 pub struct Workspace {
     #[returns(ref)]
-    pub files: BTreeMap<String, SourceFile>,
+    pub files: BTreeMap<FilePath, SourceFile>,
+    #[returns(ref)]
+    pub unread: BTreeMap<FilePath, ReadFailure>,
 }
 
 #[salsa::db]
@@ -88,42 +96,86 @@ impl Database {
             workspace: None,
             log,
         };
-        let ws = Workspace::new(&db, BTreeMap::new());
+        let ws = Workspace::new(&db, BTreeMap::new(), BTreeMap::new());
         db.workspace = Some(ws);
         for (name, text) in STDLIB {
-            db.set_file(&format!("std::{name}"), text.to_string());
+            db.set_file(&FilePath::std(name), text.to_string());
         }
         db
     }
 
-    /// Adds a file or replaces its text.
-    pub fn set_file(&mut self, path: &str, text: String) -> SourceFile {
+    /// Adds a file or replaces its text (an editor's text, or a test's).
+    pub fn set_file(&mut self, path: &(impl AsFilePath + ?Sized), text: String) -> SourceFile {
+        self.set_read_file(path.to_file_path(), text, None)
+    }
+
+    /// Adds a file as a loader read it: its decoded text and what was wrong
+    /// with its bytes.
+    pub fn set_read_file(
+        &mut self,
+        path: FilePath,
+        text: String,
+        decode: Option<DecodeProblem>,
+    ) -> SourceFile {
         let ws = self.workspace();
-        if let Some(&f) = ws.files(self).get(path) {
+        if ws.unread(self).contains_key(&path) {
+            let mut unread = ws.unread(self).clone();
+            unread.remove(&path);
+            ws.set_unread(self).to(unread);
+        }
+        if let Some(&f) = ws.files(self).get(&path) {
             if f.text(self) != &text {
                 f.set_text(self).to(text);
             }
+            if f.decode(self) != &decode {
+                f.set_decode(self).to(decode);
+            }
             return f;
         }
-        let f = SourceFile::new(self, path.to_owned(), text);
+        let f = SourceFile::new(self, path.clone(), text, decode);
         let mut files = ws.files(self).clone();
-        files.insert(path.to_owned(), f);
+        files.insert(path, f);
         ws.set_files(self).to(files);
         f
     }
 
     /// Forgets a file (deleted on disk); rules that name it report it missing.
-    pub fn remove_file(&mut self, path: &str) {
+    pub fn remove_file(&mut self, path: &(impl AsFilePath + ?Sized)) {
+        let path = path.to_file_path();
         let ws = self.workspace();
-        if ws.files(self).contains_key(path) {
+        if ws.files(self).contains_key(&path) {
             let mut files = ws.files(self).clone();
-            files.remove(path);
+            files.remove(&path);
             ws.set_files(self).to(files);
         }
     }
 
-    pub fn file(&self, path: &str) -> Option<SourceFile> {
-        self.workspace().files(self).get(path).copied()
+    /// Notes that a loader could not give this file (and forgets its text).
+    pub fn set_unread(&mut self, path: FilePath, why: ReadFailure) {
+        self.remove_file(&path);
+        let ws = self.workspace();
+        if ws.unread(self).get(&path) != Some(&why) {
+            let mut unread = ws.unread(self).clone();
+            unread.insert(path, why);
+            ws.set_unread(self).to(unread);
+        }
+    }
+
+    /// Forgets that a file could not be read (it changed on disk: ask again).
+    pub fn forget_unread(&mut self, path: &FilePath) {
+        let ws = self.workspace();
+        if ws.unread(self).contains_key(path) {
+            let mut unread = ws.unread(self).clone();
+            unread.remove(path);
+            ws.set_unread(self).to(unread);
+        }
+    }
+
+    pub fn file(&self, path: &(impl AsFilePath + ?Sized)) -> Option<SourceFile> {
+        self.workspace()
+            .files(self)
+            .get(&path.to_file_path())
+            .copied()
     }
 
     /// Every file as [`Sources`] with the ids diagnostics use, for rendering.
@@ -132,7 +184,7 @@ impl Database {
         for f in self.workspace().files(self).values() {
             s.insert(
                 file_id(self, *f),
-                f.path(self).clone(),
+                f.path(self).to_string(),
                 f.text(self).clone(),
             );
         }
@@ -178,9 +230,9 @@ pub fn parsed_rules(db: &dyn Db, file: SourceFile) -> ParsedRules {
 
 /// Whether an imported file is a BT.CPP node palette (`.xml`) rather than
 /// rules.
-pub fn is_palette(path: &str) -> bool {
-    std::path::Path::new(path)
-        .extension()
+pub fn is_palette(path: &FilePath) -> bool {
+    path.as_path()
+        .and_then(std::path::Path::extension)
         .is_some_and(|e| e.eq_ignore_ascii_case("xml"))
 }
 
@@ -251,37 +303,8 @@ pub fn rules_items(db: &dyn Db, file: SourceFile) -> Vec<RulesItem<'_>> {
 
 /// Resolves a path written in a rules file (relative to that file).
 fn resolve(db: &dyn Db, from: SourceFile, written: &str) -> Option<SourceFile> {
-    let files = db.workspace().files(db);
-    let base = std::path::Path::new(from.path(db))
-        .parent()
-        .map(|p| p.to_path_buf())
-        .unwrap_or_default();
-    let joined = base.join(written);
-    let candidates = [
-        joined.to_string_lossy().into_owned(),
-        normalize(&joined),
-        written.to_owned(),
-    ];
-    candidates.iter().find_map(|c| files.get(c).copied())
-}
-
-/// `a/./b/../c` -> `a/c`, without touching the file system; `/`
-/// separators, and an absolute path keeps its one leading `/`.
-pub fn normalize(p: &std::path::Path) -> String {
-    use std::path::Component;
-    let mut out = std::path::PathBuf::new();
-    for c in p.components() {
-        match c {
-            Component::CurDir => {}
-            Component::ParentDir
-                if matches!(out.components().next_back(), Some(Component::Normal(_))) =>
-            {
-                out.pop();
-            }
-            other => out.push(other),
-        }
-    }
-    out.to_string_lossy().replace('\\', "/")
+    let path = from.path(db).sibling(written)?;
+    db.workspace().files(db).get(&path).copied()
 }
 
 /// The path a rules file gives for its domain (or problem), as written.
@@ -377,7 +400,7 @@ pub fn import_closure(db: &dyn Db, file: SourceFile) -> (Vec<SourceFile>, Vec<Di
                 ImportTarget::Std { module } => db
                     .workspace()
                     .files(db)
-                    .get(&format!("std::{}", module.text))
+                    .get(&FilePath::std(&module.text))
                     .copied(),
                 ImportTarget::Path { path } => path.plain().and_then(|p| resolve(db, f, &p)),
             };
@@ -459,6 +482,18 @@ pub fn item_diagnostics<'db>(db: &'db dyn Db, item: RulesItem<'db>) -> Vec<Diagn
         domain_ctx(db, file),
         file_id(db, file),
     )
+}
+
+/// A rule's variables with the types the checker gives them (empty for
+/// items that are no rules): what the language server shows for a
+/// `?variable` in hovers, completions and inlay hints.
+#[salsa::tracked(returns(ref))]
+pub fn rule_var_types<'db>(db: &'db dyn Db, item: RulesItem<'db>) -> Vec<VarTypes> {
+    let Item::Rule(r) = item.item(db) else {
+        return Vec::new();
+    };
+    let file = item.file(db);
+    crate::rules::check::rule_var_types(r, declarations(db, file), domain_ctx(db, file))
 }
 
 /// What the file-level checks need of an item's head (nothing of a body).
@@ -647,7 +682,7 @@ mod tests {
             .join("..")
             .join(path);
         let text = std::fs::read_to_string(&full).unwrap();
-        db.set_file(&normalize(std::path::Path::new(path)), text)
+        db.set_file(path, text)
     }
 
     fn errors(db: &Database, f: SourceFile) -> Vec<String> {
@@ -656,16 +691,6 @@ mod tests {
             .iter()
             .map(|d| btc_pddl::render::to_short(d, &sources))
             .collect()
-    }
-
-    #[test]
-    fn normalized_paths_keep_one_root_slash() {
-        let n = |p: &str| normalize(std::path::Path::new(p));
-        assert_eq!(n("/tmp/x/./rules.btrules"), "/tmp/x/rules.btrules");
-        assert_eq!(n("/tmp/x/../domain.pddl"), "/tmp/domain.pddl");
-        assert_eq!(n("/../domain.pddl"), "/../domain.pddl");
-        assert_eq!(n("a/./b/../c"), "a/c");
-        assert_eq!(n("../a/b"), "../a/b");
     }
 
     #[test]
@@ -698,7 +723,7 @@ mod tests {
             "retry(30) MoveTo(robot: ?r, target: ?destination)",
             1,
         );
-        db.set_file(f.path(&db).clone().as_str(), text);
+        db.set_file(&f.path(&db).clone(), text);
         let after = errors(&db, f);
         let log = db.take_log();
         let rechecked = log
@@ -744,7 +769,7 @@ mod tests {
             "{}\nrule (flip ?robot ?p ?c) {{ Flip(robot: ?robot, part: ?p, container: ?c) }}\n",
             f.text(&db)
         );
-        db.set_file(f.path(&db).clone().as_str(), text);
+        db.set_file(&f.path(&db).clone(), text);
         let after = errors(&db, f);
         let log = db.take_log();
         let count = |q: &str| log.iter().filter(|l| l.starts_with(q)).count();
@@ -793,39 +818,10 @@ pub fn job_problem(db: &dyn Db, job: CompileJob) -> Option<SourceFile> {
 }
 
 /// Every diagnostic a compile job raises before lowering (rules, imports,
-/// domain, problem, plan), sorted by file and position.
+/// domain, problem, plan), in the order of [`crate::project::job_report`].
 #[salsa::tracked(returns(ref))]
 pub fn job_diagnostics(db: &dyn Db, job: CompileJob) -> Vec<Diagnostic> {
-    let rules = job.rules(db);
-    let mut out: Vec<Diagnostic> = rules_diagnostics(db, rules).clone();
-    let Some(d) = job_domain(db, job) else {
-        if declared_path(db, rules, false).is_none() {
-            // rules_diagnostics reported the missing `domain` already.
-        }
-        return out;
-    };
-    out.extend(checked_domain(db, d).diagnostics.iter().cloned());
-    let Some(p) = job_problem(db, job) else {
-        out.push(
-            Diagnostic::error(
-                codes::R_NO_DOMAIN,
-                Span::new(file_id(db, job.plan(db)), 0, 0),
-                "compiling a plan needs the PDDL problem it solves",
-            )
-            .with_hint(
-                "pass `--problem FILE`, or add `problem \"problem.pddl\"` to the rules file",
-            ),
-        );
-        return out;
-    };
-    out.extend(
-        checked_problem(db, ProblemOf::new(db, p, d))
-            .diagnostics
-            .iter()
-            .cloned(),
-    );
-    out.extend(typed_plan(db, job).diagnostics.iter().cloned());
-    out
+    crate::project::flatten(crate::project::job_report(db, job))
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -897,10 +893,10 @@ pub fn compile(db: &dyn Db, job: CompileJob) -> Result<btc_ir::TreeIr, Vec<Diagn
         pix: &cp.index,
         plan: &tp.plan,
         steps: &tp.steps,
-        domain_path: d.path(db).clone(),
-        problem_path: p.path(db).clone(),
-        plan_path: job.plan(db).path(db).clone(),
-        rules_path: rules.path(db).clone(),
+        domain_path: d.path(db).to_string(),
+        problem_path: p.path(db).to_string(),
+        plan_path: job.plan(db).path(db).to_string(),
+        rules_path: rules.path(db).to_string(),
     };
     crate::lower::lower(&input)
 }

@@ -24,7 +24,10 @@ pub fn declared_nodes(db: &dyn Db, file: SourceFile) -> Vec<DeclaredNode> {
     let mut out: Vec<DeclaredNode> = Vec::new();
     for &f in &import_closure(db, file).0 {
         let path = f.path(db);
-        let stdlib = path.strip_prefix("std::").map(str::to_owned);
+        let stdlib = match path {
+            crate::path::FilePath::Std(module) => Some(module.clone()),
+            crate::path::FilePath::Disk(_) => None,
+        };
         let fid = file_id(db, f);
         for n in &parsed_rules(db, f).items {
             let Item::Node(decl) = &n.item else { continue };

@@ -9,5 +9,7 @@
 pub mod db;
 pub mod declared;
 pub mod lower;
+pub mod path;
+pub mod project;
 pub mod rules;
 pub mod targets;

@@ -61,7 +61,7 @@ pub fn refusals(db: &dyn Db, job: CompileJob, ir: &TreeIr, target: Target) -> Ve
     let mut out = Vec::new();
     let (files, _) = db::import_closure(db, job.rules(db));
     for &file in files {
-        if file.path(db).starts_with("std::") {
+        if matches!(file.path(db), crate::path::FilePath::Std(_)) {
             continue;
         }
         let id = db::file_id(db, file);

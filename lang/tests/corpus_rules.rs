@@ -30,10 +30,7 @@ pub fn cases() -> Option<Vec<Case>> {
 }
 
 fn load(db: &mut Database, p: &Path) -> btc_lang::db::SourceFile {
-    db.set_file(
-        &btc_lang::db::normalize(p),
-        std::fs::read_to_string(p).unwrap(),
-    )
+    db.set_file(p, std::fs::read_to_string(p).unwrap())
 }
 
 #[test]

@@ -6,7 +6,8 @@
 //! diagnostic per mistake, in the user's terms (snapshot).
 
 use btc_emit::{emit, Format, Options};
-use btc_lang::db::{compile, normalize, rules_diagnostics, CompileJob, Database, SourceFile};
+use btc_lang::db::{compile, rules_diagnostics, CompileJob, Database, SourceFile};
+use btc_lang::path::FilePath;
 use std::path::{Path, PathBuf};
 
 fn repo() -> PathBuf {
@@ -15,7 +16,7 @@ fn repo() -> PathBuf {
 
 fn load(db: &mut Database, rel: &str) -> SourceFile {
     let p = repo().join(rel);
-    db.set_file(&normalize(&p), std::fs::read_to_string(&p).unwrap())
+    db.set_file(&FilePath::new(&p), std::fs::read_to_string(&p).unwrap())
 }
 
 /// `line:col [CODE] message` for each diagnostic of a rules fixture.

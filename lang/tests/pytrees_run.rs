@@ -772,7 +772,7 @@ fn corpus_plans_run_to_success() {
         plans.sort();
         for plan in plans {
             let mut db = Database::new();
-            let key = |p: &Path| btc_lang::db::normalize(p);
+            let key = |p: &Path| btc_lang::path::FilePath::new(p);
             db.set_file(
                 &key(&dir.join(written)),
                 std::fs::read_to_string(dir.join(written)).unwrap(),

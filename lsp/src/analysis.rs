@@ -6,8 +6,10 @@ use crate::syntax::FileSyntax;
 use crate::syntax::Tokens;
 use crate::workspace::Workspace;
 use btc_lang::db::{
-    action_index, checked_domain, declarations, import_closure, parsed_rules, SourceFile,
+    action_index, checked_domain, declarations, import_closure, parsed_rules, rule_var_types,
+    rules_items, SourceFile,
 };
+use btc_lang::path::FilePath;
 use btc_lang::rules::ast::{Item, ItemNode, Rule};
 use btc_lang::rules::check::{matched_actions, Decls};
 use btc_pddl::ast::{Action, Domain};
@@ -36,8 +38,8 @@ pub struct Place {
 }
 
 impl<'a> Analysis<'a> {
-    pub fn new(ws: &'a Workspace, path: &str) -> Option<Analysis<'a>> {
-        if !Workspace::is_rules(path) {
+    pub fn new(ws: &'a Workspace, path: &FilePath) -> Option<Analysis<'a>> {
+        if !path.is_rules() {
             return None;
         }
         let file = ws.file(path)?;
@@ -75,7 +77,7 @@ impl<'a> Analysis<'a> {
     /// file on disk).
     pub fn location(&self, p: &Place) -> Option<Location> {
         let path = p.file.path(&self.ws.db);
-        let uri = Url::from_file_path(path).ok()?;
+        let uri = Url::from_file_path(path.as_path()?).ok()?;
         let range = if p.file == self.file {
             self.line_index().range(p.span)
         } else {
@@ -107,22 +109,18 @@ impl<'a> Analysis<'a> {
         }
     }
 
-    /// The PDDL type(s) of a rule's `?var`: the parameter at its position in
-    /// every action the rule matches.
-    pub fn var_types(&self, r: &Rule, var: &str) -> Vec<String> {
-        let Some(pos) = r.pattern.params.iter().position(|p| p.var.text == var) else {
+    /// The PDDL type(s) of `?var` in rule `item`, as the checker types it
+    /// (`btc_lang::db::rule_var_types`): the parameter at its position in
+    /// every action the rule's template is checked against.
+    pub fn var_types(&self, item: usize, var: &str) -> Vec<String> {
+        let Some(it) = rules_items(&self.ws.db, self.file).get(item) else {
             return Vec::new();
         };
-        let mut out: Vec<String> = Vec::new();
-        for a in self.actions_of(r) {
-            if let Some(p) = a.params.get(pos) {
-                let t = p.ty.to_string();
-                if !out.contains(&t) {
-                    out.push(t);
-                }
-            }
-        }
-        out
+        rule_var_types(&self.ws.db, *it)
+            .iter()
+            .find(|v| v.name == var)
+            .map(|v| v.types.clone())
+            .unwrap_or_default()
     }
 
     /// Files in scope: this one and its imports.

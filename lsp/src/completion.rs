@@ -171,7 +171,7 @@ fn variables(a: &Analysis, offset: usize) -> Vec<CompletionItem> {
             .params
             .iter()
             .map(|p| {
-                let ty = a.var_types(r, &p.var.text);
+                let ty = a.var_types(ix, &p.var.text);
                 item(
                     format!("?{}", p.var.text),
                     CompletionItemKind::VARIABLE,

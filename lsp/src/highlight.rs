@@ -113,14 +113,14 @@ pub fn inlay_hints(a: &Analysis, range: Range) -> Vec<InlayHint> {
     let ix = a.line_index();
     let (from, to) = (ix.offset(range.start) as u32, ix.offset(range.end) as u32);
     let mut out = Vec::new();
-    for n in a.items {
+    for (k, n) in a.items.iter().enumerate() {
         let Item::Rule(r) = &n.item else { continue };
         let whole = shift(r.span, n.offset);
         if whole.end < from || whole.start > to {
             continue;
         }
         for p in &r.pattern.params {
-            let types = a.var_types(r, &p.var.text);
+            let types = a.var_types(k, &p.var.text);
             if types.is_empty() {
                 continue;
             }

@@ -38,7 +38,7 @@ pub fn hover(a: &Analysis, offset: usize) -> Option<Hover> {
         }
         Symbol::Var { item, name } => match &a.items[*item].item {
             Item::Rule(r) => {
-                let types = a.var_types(r, name);
+                let types = a.var_types(*item, name);
                 let pos = r.pattern.params.iter().position(|p| p.var.text == *name);
                 match (pos, types.is_empty()) {
                     (Some(p), false) => format!(
@@ -116,7 +116,9 @@ pub fn hover(a: &Analysis, offset: usize) -> Option<Hover> {
             format!(
                 "{}\n\ndeclared in `{}`",
                 code_block("btrules", &decl),
-                short(origin)
+                origin
+                    .file_name()
+                    .map_or_else(|| origin.to_string(), str::to_owned)
             )
         }
         Symbol::Table { name, .. } => {
@@ -198,13 +200,6 @@ pub fn hover(a: &Analysis, offset: usize) -> Option<Hover> {
         }),
         range: Some(a.range(span)),
     })
-}
-
-fn short(path: &str) -> &str {
-    std::path::Path::new(path)
-        .file_name()
-        .and_then(|n| n.to_str())
-        .unwrap_or(path)
 }
 
 /// Where the symbol at `offset` is defined.

@@ -96,16 +96,16 @@ fn isolated<T>(f: impl FnOnce() -> T) -> Result<T> {
 }
 
 /// The database path of a document URI (an absolute file path).
-pub fn path_of(uri: &Url) -> Option<String> {
+pub fn path_of(uri: &Url) -> Option<btc_lang::path::FilePath> {
     let p = uri.to_file_path().ok()?;
-    Some(btc_lang::db::normalize(&p))
+    Some(btc_lang::path::FilePath::new(p))
 }
 
 fn convert_file(
     ws: &Workspace,
     fd: FileDiagnostics,
 ) -> Option<(Url, Vec<tower_lsp::lsp_types::Diagnostic>, Option<i32>)> {
-    let uri = Url::from_file_path(&fd.path).ok()?;
+    let uri = Url::from_file_path(fd.path.as_path()?).ok()?;
     let text = ws.text(&fd.path).unwrap_or_default();
     let ix = LineIndex::new(text);
     let capped =
@@ -127,7 +127,7 @@ pub fn to_lsp(ws: &Workspace, ix: &LineIndex, d: &Diagnostic) -> tower_lsp::lsp_
         .iter()
         .filter_map(|l| {
             let path = ws.path_of(l.span.file)?;
-            let uri = Url::from_file_path(&path).ok()?;
+            let uri = Url::from_file_path(path.as_path()?).ok()?;
             let text = ws.text(&path)?;
             Some(DiagnosticRelatedInformation {
                 location: Location::new(uri, LineIndex::new(text).range(l.span)),

@@ -1,33 +1,67 @@
 //! The server's view of the files: the salsa database of `btc check`, the
-//! documents the editor has open, and the PDDL files and imports those
-//! documents name, read from disk. Paths in the database are absolute file
-//! system paths (the stdlib's are `std::NAME`).
+//! documents the editor has open, and the files those documents name, read
+//! from disk by the project loader (`btc_lang::project`) — the same loader,
+//! and the same reports, as `btc check`. Paths are the documents' absolute
+//! file system paths.
 
 use crate::convert::LineIndex;
-use btc_lang::db::{
-    checked_domain, checked_problem, domain_file, file_id, normalize, parsed_rules, problem_file,
-    rules_diagnostics, Database, Db as _, ProblemOf, SourceFile,
-};
-use btc_lang::rules::{ImportTarget, Item};
+use btc_lang::db::{file_id, Database, Db as _, SourceFile};
+use btc_lang::path::FilePath;
+use btc_lang::project::{self, FileLoader, Loaded, ReadFailure};
 use btc_pddl::diagnostic::Diagnostic;
-use std::collections::{BTreeMap, BTreeSet};
-use std::path::Path;
+use std::collections::{BTreeMap, BTreeSet, HashSet};
+use std::path::{Path, PathBuf};
 use tower_lsp::lsp_types::TextDocumentContentChangeEvent;
 
 /// Files larger than this are not read from disk (the CLI's limit is 1 GiB;
 /// an editor has no use for more than this).
 const MAX_DISK_FILE: usize = 64 << 20;
 
+/// The disk as the language server reads it, through the CLI's bounded
+/// reader (devices and folders are refused, nothing is read past the
+/// limit). Open documents come from the editor instead.
+pub struct Disk;
+
+impl FileLoader for Disk {
+    fn read(&self, path: &Path) -> Result<Loaded, ReadFailure> {
+        match btc_files::read(path, MAX_DISK_FILE) {
+            Ok(bytes) => Ok(Loaded::from_bytes(&bytes)),
+            Err(btc_files::ReadError::Io(e)) if e.kind() == std::io::ErrorKind::NotFound => {
+                Err(ReadFailure::NotFound)
+            }
+            Err(e @ btc_files::ReadError::NotAFile { .. }) => Err(ReadFailure::NotAFile {
+                reason: e.to_string(),
+            }),
+            Err(e) => Err(ReadFailure::Unreadable {
+                reason: e.to_string(),
+            }),
+        }
+    }
+
+    fn list(&self, dir: &Path) -> Vec<PathBuf> {
+        let mut out: Vec<PathBuf> = std::fs::read_dir(dir)
+            .into_iter()
+            .flatten()
+            .filter_map(Result::ok)
+            .map(|e| e.path())
+            .filter(|p| p.is_file())
+            .collect();
+        out.sort();
+        out
+    }
+}
+
 pub struct Workspace {
     pub db: Database,
     /// Open documents: path to the editor's version.
-    open: BTreeMap<String, i32>,
+    open: BTreeMap<FilePath, i32>,
     /// Paths that had diagnostics at the last publication: they get an empty
     /// list when their problems are gone.
-    published: BTreeSet<String>,
+    published: BTreeSet<FilePath>,
     /// Open documents over [`MAX_ANALYSED`]: their text (edits still apply)
     /// while the database holds them empty.
-    oversize: BTreeMap<String, String>,
+    oversize: BTreeMap<FilePath, String>,
+    loader: Box<dyn FileLoader + Send>,
 }
 
 /// The largest document the server analyses; a larger one gets one
@@ -36,7 +70,7 @@ pub const MAX_ANALYSED: usize = 16 << 20;
 
 /// One file's diagnostics, ready to publish.
 pub struct FileDiagnostics {
-    pub path: String,
+    pub path: FilePath,
     pub version: Option<i32>,
     pub diagnostics: Vec<Diagnostic>,
 }
@@ -48,24 +82,27 @@ impl Default for Workspace {
 }
 
 impl Workspace {
+    /// A workspace over the disk.
     pub fn new() -> Workspace {
+        Workspace::with_loader(Box::new(Disk))
+    }
+
+    /// A workspace whose files not open in the editor come from `loader`.
+    pub fn with_loader(loader: Box<dyn FileLoader + Send>) -> Workspace {
         Workspace {
             db: Database::new(),
             open: BTreeMap::new(),
             published: BTreeSet::new(),
             oversize: BTreeMap::new(),
+            loader,
         }
     }
 
-    pub fn is_rules(path: &str) -> bool {
-        path.ends_with(".btrules") || path.starts_with("std::")
-    }
-
-    pub fn file(&self, path: &str) -> Option<SourceFile> {
+    pub fn file(&self, path: &FilePath) -> Option<SourceFile> {
         self.db.file(path)
     }
 
-    pub fn text(&self, path: &str) -> Option<&str> {
+    pub fn text(&self, path: &FilePath) -> Option<&str> {
         if let Some(t) = self.oversize.get(path) {
             return Some(t);
         }
@@ -73,31 +110,31 @@ impl Workspace {
     }
 
     /// An editor's text into the database, unless it is too large to analyse.
-    fn set_document(&mut self, path: &str, text: String) {
+    fn set_document(&mut self, path: &FilePath, text: String) -> SourceFile {
         if text.len() > MAX_ANALYSED {
-            self.db.set_file(path, String::new());
-            self.oversize.insert(path.to_owned(), text);
+            self.oversize.insert(path.clone(), text);
+            self.db.set_file(path, String::new())
         } else {
             self.oversize.remove(path);
-            self.db.set_file(path, text);
+            self.db.set_file(path, text)
         }
     }
 
-    pub fn is_open(&self, path: &str) -> bool {
+    pub fn is_open(&self, path: &FilePath) -> bool {
         self.open.contains_key(path)
     }
 
-    pub fn open(&mut self, path: &str, text: String, version: i32) {
-        self.open.insert(path.to_owned(), version);
-        self.set_document(path, text);
-        self.load_dependencies(path);
+    pub fn open(&mut self, path: &FilePath, text: String, version: i32) {
+        self.open.insert(path.clone(), version);
+        let f = self.set_document(path, text);
+        project::load_references(&mut self.db, self.loader.as_ref(), f);
     }
 
     /// Applies the editor's changes (ranges in UTF-16 positions, applied in
     /// order, each to the text the previous one left).
     pub fn change(
         &mut self,
-        path: &str,
+        path: &FilePath,
         changes: Vec<TextDocumentContentChangeEvent>,
         version: i32,
     ) {
@@ -113,13 +150,11 @@ impl Workspace {
                 None => text = c.text,
             }
         }
-        self.open.insert(path.to_owned(), version);
-        self.set_document(path, text);
-        self.load_dependencies(path);
+        self.open(path, text, version);
     }
 
     /// The editor closed a document: what is on disk counts again.
-    pub fn close(&mut self, path: &str) {
+    pub fn close(&mut self, path: &FilePath) {
         self.open.remove(path);
         self.oversize.remove(path);
         self.reload_from_disk(path);
@@ -127,58 +162,15 @@ impl Workspace {
 
     /// A watched file changed, appeared or went away on disk. Open documents
     /// keep the editor's text.
-    pub fn changed_on_disk(&mut self, path: &str) {
+    pub fn changed_on_disk(&mut self, path: &FilePath) {
         if !self.is_open(path) {
             self.reload_from_disk(path);
         }
     }
 
-    fn reload_from_disk(&mut self, path: &str) {
-        match read(Path::new(path)) {
-            Some(text) => {
-                self.db.set_file(path, text);
-                self.load_dependencies(path);
-            }
-            None => self.db.remove_file(path),
-        }
-    }
-
-    /// Reads the domain, problem and imports a rules file names (and theirs)
-    /// from disk when the database does not have them yet.
-    fn load_dependencies(&mut self, path: &str) {
-        let mut todo = vec![path.to_owned()];
-        let mut seen = BTreeSet::new();
-        while let Some(p) = todo.pop() {
-            if !Workspace::is_rules(&p) || !seen.insert(p.clone()) {
-                continue;
-            }
-            let Some(f) = self.db.file(&p) else { continue };
-            let dir = Path::new(&p)
-                .parent()
-                .map(Path::to_path_buf)
-                .unwrap_or_default();
-            let mut wanted = Vec::new();
-            for n in &parsed_rules(&self.db, f).items {
-                match &n.item {
-                    Item::Domain { path, .. } | Item::Problem { path, .. } => {
-                        wanted.extend(path.plain())
-                    }
-                    Item::Import {
-                        target: ImportTarget::Path { path },
-                        ..
-                    } => wanted.extend(path.plain()),
-                    _ => {}
-                }
-            }
-            for w in wanted {
-                let full = normalize(&dir.join(&w));
-                if self.db.file(&full).is_none() {
-                    if let Some(text) = read(Path::new(&full)) {
-                        self.db.set_file(&full, text);
-                    }
-                }
-                todo.push(full);
-            }
+    fn reload_from_disk(&mut self, path: &FilePath) {
+        if let Ok(f) = project::read_file(&mut self.db, self.loader.as_ref(), path) {
+            project::load_references(&mut self.db, self.loader.as_ref(), f);
         }
     }
 
@@ -186,7 +178,7 @@ impl Workspace {
     pub fn open_rules(&self) -> Vec<SourceFile> {
         self.open
             .keys()
-            .filter(|p| Workspace::is_rules(p))
+            .filter(|p| p.is_rules())
             .filter_map(|p| self.db.file(p))
             .collect()
     }
@@ -197,13 +189,13 @@ impl Workspace {
             .workspace()
             .files(&self.db)
             .iter()
-            .filter(|(p, _)| p.ends_with(".btrules"))
+            .filter(|(p, _)| matches!(p, FilePath::Disk(_)) && p.is_rules())
             .map(|(_, f)| *f)
             .collect()
     }
 
     /// The path of a file id.
-    pub fn path_of(&self, id: btc_pddl::source::FileId) -> Option<String> {
+    pub fn path_of(&self, id: btc_pddl::source::FileId) -> Option<FilePath> {
         self.db
             .workspace()
             .files(&self.db)
@@ -212,80 +204,70 @@ impl Workspace {
             .map(|(p, _)| p.clone())
     }
 
-    /// Diagnostics of every open rules document and of the PDDL files they
-    /// name (and of open PDDL domains), grouped by file; files that had
-    /// diagnostics last time and have none now get an empty list.
+    /// The reports of every open rules document (as `btc check` makes them:
+    /// `btc_lang::project::project_report`) and of open PDDL domains that no
+    /// rules file names, grouped by file in the reports' order; files that
+    /// had diagnostics last time and have none now get an empty list.
     pub fn diagnostics(&mut self) -> Vec<FileDiagnostics> {
-        let mut by_path: BTreeMap<String, Vec<Diagnostic>> = BTreeMap::new();
-        let mut ids: BTreeMap<btc_pddl::source::FileId, String> = BTreeMap::new();
+        let mut ids: BTreeMap<btc_pddl::source::FileId, FilePath> = BTreeMap::new();
         for (p, f) in self.db.workspace().files(&self.db) {
             ids.insert(file_id(&self.db, *f), p.clone());
         }
-        let add = |d: &Diagnostic, by_path: &mut BTreeMap<String, Vec<Diagnostic>>| {
-            if let Some(p) = ids.get(&d.span.file) {
-                let list = by_path.entry(p.clone()).or_default();
-                if !list.contains(d) {
-                    list.push(d.clone());
+        let mut by_path: BTreeMap<FilePath, Vec<Diagnostic>> = BTreeMap::new();
+        // A PDDL file two rules files name is reported once.
+        let mut reported: HashSet<SourceFile> = HashSet::new();
+        let roots = self.open_rules();
+        for &r in &roots {
+            for (i, section) in project::project_report(&self.db, r).iter().enumerate() {
+                // An open rules file reports itself; any other file once.
+                let root = i == 0;
+                if !root && (roots.contains(&section.file) || !reported.insert(section.file)) {
+                    continue;
                 }
-            }
-        };
-        let mut pddl_seen = std::collections::HashSet::new();
-        for r in self.open_rules() {
-            by_path.entry(r.path(&self.db).clone()).or_default();
-            for d in rules_diagnostics(&self.db, r) {
-                add(d, &mut by_path);
-            }
-            let domain = domain_file(&self.db, r);
-            if let Some(d) = domain {
-                if pddl_seen.insert(d) {
-                    for x in &checked_domain(&self.db, d).diagnostics {
-                        add(x, &mut by_path);
-                    }
-                }
-                if let Some(p) = problem_file(&self.db, r) {
-                    if pddl_seen.insert(p) {
-                        for x in
-                            &checked_problem(&self.db, ProblemOf::new(&self.db, p, d)).diagnostics
-                        {
-                            add(x, &mut by_path);
-                        }
+                by_path
+                    .entry(section.file.path(&self.db).clone())
+                    .or_default();
+                for d in &section.diagnostics {
+                    if let Some(p) = ids.get(&d.span.file) {
+                        by_path.entry(p.clone()).or_default().push(d.clone());
                     }
                 }
             }
         }
         // Open PDDL domains that no rules file names are checked alone.
         for p in self.open.keys() {
-            if !p.ends_with(".pddl") {
+            if !p.has_extension("pddl") {
                 continue;
             }
             let Some(f) = self.db.file(p) else { continue };
-            if pddl_seen.contains(&f) {
+            if reported.contains(&f) {
                 continue;
             }
-            by_path.entry(p.clone()).or_default();
-            let cd = checked_domain(&self.db, f);
+            let cd = btc_lang::db::checked_domain(&self.db, f);
+            let list = by_path.entry(p.clone()).or_default();
             if cd.domain.is_some() {
-                for x in &cd.diagnostics {
-                    add(x, &mut by_path);
-                }
+                list.extend(
+                    project::report::read_diagnostics(&self.db, f)
+                        .iter()
+                        .cloned(),
+                );
+                list.extend(cd.diagnostics.iter().cloned());
             }
         }
         for (p, t) in &self.oversize {
             let Some(f) = self.db.file(p) else { continue };
             let id = file_id(&self.db, f);
             // Only this: the (empty) text the database holds says nothing.
-            by_path.insert(p.clone(), Vec::new());
-            by_path.entry(p.clone()).or_default().push(Diagnostic::error(
+            by_path.insert(p.clone(), vec![Diagnostic::error(
                 btc_pddl::diagnostic::codes::DOCUMENT_TOO_LARGE,
                 btc_pddl::source::Span::new(id, 0, 0),
                 format!(
                     "this document has {} bytes; the language server analyses documents of at most {MAX_ANALYSED} bytes",
                     t.len()
                 ),
-            ).with_hint("`btc check` reads files up to 1 GiB"));
+            ).with_hint("`btc check` reads files up to 1 GiB")]);
         }
-        let mut out = Vec::new();
-        let now: BTreeSet<String> = by_path
+        let now: BTreeSet<FilePath> = by_path
             .iter()
             .filter(|(_, d)| !d.is_empty())
             .map(|(p, _)| p.clone())
@@ -293,8 +275,9 @@ impl Workspace {
         for gone in self.published.difference(&now) {
             by_path.entry(gone.clone()).or_default();
         }
+        let mut out = Vec::new();
         for (path, diagnostics) in by_path {
-            if path.starts_with("std::") {
+            if matches!(path, FilePath::Std(_)) {
                 continue;
             }
             out.push(FileDiagnostics {
@@ -308,20 +291,8 @@ impl Workspace {
     }
 
     /// Where a rules file's `domain` / `problem` / import string points.
-    pub fn resolve_written(&self, from: SourceFile, written: &str) -> Option<String> {
-        let dir = Path::new(from.path(&self.db))
-            .parent()
-            .map(Path::to_path_buf)
-            .unwrap_or_default();
-        let full = normalize(&dir.join(written));
+    pub fn resolve_written(&self, from: SourceFile, written: &str) -> Option<FilePath> {
+        let full = from.path(&self.db).sibling(written)?;
         self.db.file(&full).map(|_| full)
     }
-}
-
-/// A file's text from disk, or `None` when it cannot be read as text
-/// (through the CLI's bounded reader: devices and folders are refused,
-/// nothing is read past the limit).
-fn read(path: &Path) -> Option<String> {
-    let bytes = btc_files::read(path, MAX_DISK_FILE).ok()?;
-    Some(btc_pddl::source::decode(&bytes).0)
 }

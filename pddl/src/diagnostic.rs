@@ -286,6 +286,7 @@ pub mod codes {
         PLAN_UNKNOWN_OBJECT = "L004", "a plan step argument that is no object or constant";
         PLAN_TYPE = "L005", "a plan step argument whose type does not fit the action";
         PLAN_EMPTY = "L006", "a plan with no steps";
+        PLAN_MISFIT = "L010", "a plan whose object names are not those of its problem";
         // Validation
         PRECONDITION_FAILS = "V001", "a plan step whose precondition does not hold";
         GOAL_NOT_REACHED = "V002", "a plan that does not reach the goal";

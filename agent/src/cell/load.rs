@@ -4,6 +4,7 @@
 
 use super::{Cell, CellSpec};
 use btc_lang::db::{self, Database};
+use btc_lang::path::FilePath;
 use btc_pddl::diagnostic::Diagnostic;
 use std::path::{Path, PathBuf};
 
@@ -25,20 +26,20 @@ pub fn load(
 ) -> Result<Cell, LoadError> {
     let mut get = |p: &Path| read(p).map_err(|e| LoadError::Read(p.to_path_buf(), e));
     let text = get(path)?;
-    let cf = db.set_file(&db::normalize(path), text.clone());
+    let cf = db.set_file(path, text.clone());
     let cid = db::file_id(db, cf);
     let spec = CellSpec::parse(&text, cid).map_err(LoadError::Invalid)?;
     let dir = path.parent().unwrap_or(Path::new("."));
     let dpath = dir.join(&spec.domain);
     let dtext = get(&dpath)?;
-    let dname = db::normalize(&dpath);
+    let dname = FilePath::new(&dpath).to_string();
     let df = db.set_file(&dname, dtext.clone());
     let did = db::file_id(db, df);
     let mut rules = Vec::new();
     for r in &spec.robots {
         let rpath = dir.join(&r.rules);
         let rtext = get(&rpath)?;
-        let rname = db::normalize(&rpath);
+        let rname = FilePath::new(&rpath).to_string();
         db.set_file(&rname, rtext.clone());
         rules.push((r.robot, rname, rtext));
     }

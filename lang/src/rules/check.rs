@@ -865,6 +865,72 @@ fn check_node(n: &NodeDecl, ctx: Option<DomainCtx>) -> Vec<Diagnostic> {
     diags
 }
 
+/// The actions a rule's template is typed by, from what the rule can reach
+/// through its tables: those a step can come from, or, for a rule that can
+/// match nothing, those it names.
+fn typing_actions<'d>(
+    through_tables: &[&(&'d btc_pddl::ast::Action, usize, Captures, Verdict)],
+) -> Vec<&'d btc_pddl::ast::Action> {
+    let can: Vec<&'d btc_pddl::ast::Action> = through_tables
+        .iter()
+        .filter(|(_, _, _, v)| *v == Verdict::Can)
+        .map(|(a, _, _, _)| *a)
+        .collect();
+    if !can.is_empty() {
+        return can;
+    }
+    through_tables
+        .iter()
+        .filter(|(_, _, _, v)| matches!(v, Verdict::Never(_)))
+        .map(|(a, _, _, _)| *a)
+        .collect()
+}
+
+/// What a rule's `?variable`s are, as the checker types them: for each
+/// pattern variable in order, the types (as the domain writes them) of the
+/// parameter it stands for in every action the template is checked
+/// against. Empty lists without a domain or a matching action.
+pub fn rule_var_types(r: &Rule, decls: &Decls, ctx: Option<DomainCtx>) -> Vec<VarTypes> {
+    let mut out: Vec<VarTypes> = Vec::new();
+    for p in &r.pattern.params {
+        if !out.iter().any(|v| v.name == p.var.text) {
+            out.push(VarTypes {
+                name: p.var.text.clone(),
+                types: Vec::new(),
+            });
+        }
+    }
+    let Some(c) = ctx else { return out };
+    let reach = reach(r, decls, c);
+    let through_tables: Vec<_> = reach
+        .named
+        .iter()
+        .filter(|(_, _, _, v)| *v != Verdict::NotInTable)
+        .collect();
+    for action in typing_actions(&through_tables) {
+        for v in &mut out {
+            // The parameter at the variable's first position.
+            let Some(pos) = r.pattern.params.iter().position(|p| p.var.text == v.name) else {
+                continue;
+            };
+            if let Some(ap) = action.params.get(pos) {
+                let t = ap.ty.to_string();
+                if !v.types.contains(&t) {
+                    v.types.push(t);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// One of a rule's variables and the types the checker gives it.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub struct VarTypes {
+    pub name: String,
+    pub types: Vec<String>,
+}
+
 fn check_rule(r: &Rule, decls: &Decls, ctx: Option<DomainCtx>) -> Vec<Diagnostic> {
     let mut diags: Vec<Diagnostic> = Vec::new();
     let push = |d: Diagnostic, diags: &mut Vec<Diagnostic>| {
@@ -985,20 +1051,8 @@ fn check_rule(r: &Rule, decls: &Decls, ctx: Option<DomainCtx>) -> Vec<Diagnostic
     // The template is checked once per action a step can come from (its
     // variables are typed by that action's parameters); a rule that can
     // match nothing is still checked, with the actions it names.
-    let can: Vec<&&(&btc_pddl::ast::Action, usize, Captures, Verdict)> = through_tables
-        .iter()
-        .filter(|(_, _, _, v)| *v == Verdict::Can)
-        .collect();
-    let typed: Vec<&btc_pddl::ast::Action> = if can.is_empty() {
-        through_tables
-            .iter()
-            .filter(|(_, _, _, v)| matches!(v, Verdict::Never(_)))
-            .map(|(a, _, _, _)| *a)
-            .collect()
-    } else {
-        can.iter().map(|(a, _, _, _)| *a).collect()
-    };
-    for action in typed {
+    let none_can = !through_tables.iter().any(|(_, _, _, v)| *v == Verdict::Can);
+    for action in typing_actions(&through_tables) {
         let vars = rule_vars(r, Some((action, &c)));
         let mut tcx = Tcx {
             decls,
@@ -1024,7 +1078,7 @@ fn check_rule(r: &Rule, decls: &Decls, ctx: Option<DomainCtx>) -> Vec<Diagnostic
                 }
             }
             // A rule no step can match skips nothing (R040-R043 say so).
-            RuleBody::Skip { .. } if can.is_empty() => {}
+            RuleBody::Skip { .. } if none_can => {}
             RuleBody::Skip { span } => {
                 let changed = super::skip::changes(r, action);
                 if !changed.is_empty() {

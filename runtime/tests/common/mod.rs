@@ -25,7 +25,7 @@ pub fn fixture(name: &str) -> String {
 /// plan and the problem of the plan's stem beside it.
 pub fn corpus_job(rules: &Path, rules_text: &str, plan: &Path) -> (Database, CompileJob) {
     let mut db = Database::new();
-    let key = |p: &Path| db::normalize(p);
+    let key = |p: &Path| btc_lang::path::FilePath::new(p);
     let dir = rules.parent().unwrap();
     let written = rules_text
         .lines()
@@ -98,9 +98,12 @@ pub fn load(rules: &Path, plan: &Path, problem: &Path) -> Example {
     names.sort();
     names.dedup();
     for p in &names {
-        db.set_file(&db::normalize(p), std::fs::read_to_string(p).unwrap());
+        db.set_file(
+            &btc_lang::path::FilePath::new(p),
+            std::fs::read_to_string(p).unwrap(),
+        );
     }
-    let file = |p: &Path| db.file(&db::normalize(p)).unwrap();
+    let file = |p: &Path| db.file(&btc_lang::path::FilePath::new(p)).unwrap();
     let job = CompileJob::new(&db, file(rules), file(plan), Some(file(problem)), None);
     let ir = db::compile(&db, job)
         .as_ref()

@@ -1,0 +1,160 @@
+//! Whether a job's plan is for the job's problem: its object names (one
+//! diagnostic, L010, for a plan written for another problem) and its steps
+//! replayed from the problem's initial state (V001, V002).
+
+use crate::db::{
+    checked_domain, checked_problem, job_domain, job_problem, typed_plan, CompileJob, Db,
+    ProblemOf, SourceFile,
+};
+use crate::path::FilePath;
+use btc_pddl::diagnostic::{has_errors, Diagnostic};
+use btc_pddl::plan::fit::fold_unknown_objects;
+use btc_pddl::plan::NameFit;
+
+/// The plan's typing diagnostics, with a plan for another problem reported
+/// once (L010) instead of at every unknown name.
+#[salsa::tracked(returns(ref))]
+pub fn plan_diagnostics(db: &dyn Db, job: CompileJob) -> Vec<Diagnostic> {
+    let tp = typed_plan(db, job);
+    let (Some(d), Some(p)) = (job_domain(db, job), job_problem(db, job)) else {
+        return tp.diagnostics.clone();
+    };
+    let cp = checked_problem(db, ProblemOf::new(db, p, d));
+    let fit = NameFit::of(&tp.plan, &cp.index);
+    if fit.fits() {
+        return tp.diagnostics.clone();
+    }
+    let fitting: Vec<String> = neighbours(db, job)
+        .into_iter()
+        .filter(|n| {
+            NameFit::of(
+                &tp.plan,
+                &checked_problem(db, ProblemOf::new(db, *n, d)).index,
+            )
+            .fits()
+        })
+        .map(|n| n.path(db).to_string())
+        .collect();
+    if !fit.misfits(&fitting) {
+        return tp.diagnostics.clone();
+    }
+    let objects = cp.problem.as_ref().and_then(|p| {
+        let (first, last) = (p.objects.first()?, p.objects.last()?);
+        Some(first.name.span.to(last.name.span))
+    });
+    let mut misfit = fit.diagnostic(&p.path(db).to_string(), objects, &fitting);
+    if let [one] = fitting.as_slice() {
+        misfit.hint = misfit.hint.map(|h| format!("{h}: pass `--problem {one}`"));
+    }
+    fold_unknown_objects(&tp.diagnostics, misfit)
+}
+
+/// The problems beside the job's plan that the database holds, other than
+/// the job's (PDDL files that parse as problems of the job's domain).
+pub fn neighbours(db: &dyn Db, job: CompileJob) -> Vec<SourceFile> {
+    let plan = job.plan(db);
+    let (Some(d), Some(p)) = (job_domain(db, job), job_problem(db, job)) else {
+        return Vec::new();
+    };
+    let Some(dir) = plan.path(db).dir() else {
+        return Vec::new();
+    };
+    db.workspace()
+        .files(db)
+        .iter()
+        .filter(|(path, f)| {
+            path.has_extension("pddl") && path.dir().as_ref() == Some(&dir) && **f != p && **f != d
+        })
+        .map(|(_, f)| *f)
+        .filter(|f| {
+            checked_problem(db, ProblemOf::new(db, *f, d))
+                .problem
+                .is_some()
+        })
+        .collect()
+}
+
+/// The plan replayed from the problem's initial state: the first step whose
+/// precondition fails (V001), or the goal it does not reach (V002). Empty
+/// while the job has errors (the steps are not all typed then).
+#[salsa::tracked(returns(ref))]
+pub fn plan_validation(db: &dyn Db, job: CompileJob) -> Vec<Diagnostic> {
+    if has_errors(&super::report::flatten(super::report::job_report(db, job))) {
+        return Vec::new();
+    }
+    let (Some(d), Some(p)) = (job_domain(db, job), job_problem(db, job)) else {
+        return Vec::new();
+    };
+    let valid_for = |problem: SourceFile| -> Option<Vec<Diagnostic>> {
+        let cd = checked_domain(db, d);
+        let cp = checked_problem(db, ProblemOf::new(db, problem, d));
+        let (domain, prob) = (cd.domain.as_ref()?, cp.problem.as_ref()?);
+        let tp = if problem == p {
+            typed_plan(db, job).clone()
+        } else {
+            let (steps, diags) =
+                btc_pddl::plan::type_plan(&typed_plan(db, job).plan, domain, &cd.index, &cp.index);
+            if has_errors(&diags) {
+                return None;
+            }
+            crate::db::TypedPlan {
+                plan: typed_plan(db, job).plan.clone(),
+                steps,
+                diagnostics: diags,
+            }
+        };
+        let v = btc_pddl::validate::validate_plan(
+            domain, prob, &cd.index, &cp.index, &tp.plan, &tp.steps,
+        );
+        // A world the logic layer cannot build is reported by the checks.
+        v.ok().map(|v| v.diagnostics)
+    };
+    let Some(mut diags) = valid_for(p) else {
+        return Vec::new();
+    };
+    if diags.is_empty() {
+        return diags;
+    }
+    let valid: Vec<String> = neighbours(db, job)
+        .into_iter()
+        .filter(|n| valid_for(*n).is_some_and(|d| d.is_empty()))
+        .map(|n| n.path(db).to_string())
+        .collect();
+    let advice = match valid.as_slice() {
+        [] => format!(
+            "the plan was replayed on `{}`; `--allow-invalid-plan` compiles it anyway",
+            p.path(db)
+        ),
+        [one] => format!("the plan is valid for `{one}` beside it: pass `--problem {one}`"),
+        many => format!(
+            "the plan is valid for {}",
+            many.iter()
+                .map(|m| format!("`{m}`"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    };
+    for d in &mut diags {
+        d.hint = Some(match d.hint.take() {
+            Some(h) => format!("{h}; {advice}"),
+            None => advice.clone(),
+        });
+    }
+    diags
+}
+
+/// Whether looking at the problems beside the plan could say more: the
+/// plan names objects the problem lacks, or does not replay on it.
+pub fn wants_neighbours(db: &dyn Db, job: CompileJob) -> bool {
+    let (Some(d), Some(p)) = (job_domain(db, job), job_problem(db, job)) else {
+        return false;
+    };
+    let cp = checked_problem(db, ProblemOf::new(db, p, d));
+    !NameFit::of(&typed_plan(db, job).plan, &cp.index).fits()
+        || !plan_validation(db, job).is_empty()
+}
+
+/// The folder a plan's neighbours are in.
+pub fn plan_dir(db: &dyn Db, job: CompileJob) -> Option<FilePath> {
+    job.plan(db).path(db).dir()
+}
