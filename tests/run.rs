@@ -549,3 +549,58 @@ fn an_xml_tree_runs_with_the_trees_it_includes() {
     );
     assert_eq!(summary(&out)["status"], "SUCCESS");
 }
+
+/// A fault undoes a finished step's work (the part slips out of the
+/// gripper); `retry(3) sequence { steps backchained }` ticks the plan
+/// again, redoes the grasp, and the grasp's effect holds again, from the
+/// rules and from the compiled XML alike.
+#[test]
+fn a_step_redone_after_a_fault_re_establishes_its_effects() {
+    let rules = "tests/fixtures/run/redo/rules.btrules";
+    let fault = "examples/ariac/faults/dropped_part.toml";
+    let out = btc(&[
+        "run",
+        rules,
+        "--plan",
+        "examples/ariac/plan.txt",
+        "--faults",
+        fault,
+        "--format",
+        "json",
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    let s = summary(&out);
+    assert_eq!(s["goal_reached"], true);
+    assert_eq!(s["faults"][0]["ended"], "recovered", "{s}");
+    let dir = tempfile::tempdir().unwrap();
+    let tree = dir.path().join("tree.xml");
+    let done = btc(&[
+        "compile",
+        rules,
+        "--plan",
+        "examples/ariac/plan.txt",
+        "--emit",
+        "btcpp",
+        "-o",
+        tree.to_str().unwrap(),
+    ]);
+    assert_eq!(done.status.code(), Some(0));
+    let out = btc(&[
+        "run",
+        "--tree",
+        tree.to_str().unwrap(),
+        "--problem",
+        "examples/ariac/problem.pddl",
+        "--faults",
+        fault,
+        "--format",
+        "json",
+    ]);
+    assert_eq!(out.status.code(), Some(0));
+    assert_eq!(summary(&out)["goal_reached"], true);
+}

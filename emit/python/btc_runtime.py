@@ -496,10 +496,11 @@ class PlanStep(py_trees.decorators.Decorator):
                 self.feedback_message = "precondition does not hold"
                 yield from self._end(Status.FAILURE)
                 return
-            if not kb.started[k]:
-                kb.started[k] = True
-                if step.eff_start is not None:
-                    kb.apply(step.eff_start, step.env)
+            # Each run of the step applies its effects: a step redone (a
+            # retry after a fault undid its work) re-establishes them.
+            kb.started[k] = True
+            if step.eff_start is not None:
+                kb.apply(step.eff_start, step.env)
         yield from self.decorated.tick()
         s = self.decorated.status
         if s not in _DONE:
@@ -511,7 +512,7 @@ class PlanStep(py_trees.decorators.Decorator):
             if step.pre_end is not None and not kb.holds(step.pre_end, step.env):
                 self.feedback_message = "at-end condition does not hold"
                 s = Status.FAILURE
-            elif not kb.finished[k]:
+            else:
                 kb.finished[k] = True
                 if step.eff_end is not None:
                     kb.apply(step.eff_end, step.env)

@@ -168,13 +168,12 @@ NodeStatus KbStep::tick()
                                   kb_.whyNot(*st.start_condition));
       return NodeStatus::FAILURE;
     }
-    if(!st.started)
+    // Each run of the step applies its effects: a step redone (a retry
+    // after a fault undid its work) re-establishes them.
+    st.started = true;
+    if(st.start_effect)
     {
-      st.started = true;
-      if(st.start_effect)
-      {
-        kb_.apply(*st.start_effect);
-      }
+      kb_.apply(*st.start_effect);
     }
   }
   kb_.enterStep(number_);
@@ -204,15 +203,12 @@ NodeStatus KbStep::tick()
                                 kb_.whyNot(*st.end_condition));
     return NodeStatus::FAILURE;
   }
-  if(!st.finished)
+  st.finished = true;
+  if(st.end_effect)
   {
-    st.finished = true;
-    if(st.end_effect)
-    {
-      kb_.apply(*st.end_effect);
-    }
-    kb_.stepEvent(StepEvent::Kind::Finished, number_);
+    kb_.apply(*st.end_effect);
   }
+  kb_.stepEvent(StepEvent::Kind::Finished, number_);
   return NodeStatus::SUCCESS;
 }
 

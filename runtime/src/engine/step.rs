@@ -1,5 +1,6 @@
 //! Plan steps: a step node wraps the subtree of one plan step; it checks
-//! the step's conditions and applies its effects to the KB.
+//! the step's conditions and applies its effects to the KB, each time it
+//! runs.
 
 use super::record::Reason;
 use super::{Engine, NodeDef, Status, TraceItem};
@@ -59,12 +60,12 @@ impl<'w> Engine<'w> {
                         }
                     }
                 }
-                if !st.started {
-                    let eff = st.eff_start;
-                    self.steps[ku].started = true;
-                    if let (Some(e), Some(kb)) = (eff, self.kb.as_mut()) {
-                        kb.apply(e);
-                    }
+                // Each run of the step applies its effects: a step redone
+                // (a retry after a fault undid its work) re-establishes them.
+                let eff = st.eff_start;
+                self.steps[ku].started = true;
+                if let (Some(e), Some(kb)) = (eff, self.kb.as_mut()) {
+                    kb.apply(e);
                 }
             }
         }
@@ -84,21 +85,19 @@ impl<'w> Engine<'w> {
                     return Status::Failure;
                 }
             }
-            if !st.finished {
-                let eff = st.eff_end;
-                self.steps[ku].finished = true;
-                if self.step_running == Some(k) {
-                    self.step_running = None;
-                }
-                if let (Some(e), Some(kb)) = (eff, self.kb.as_mut()) {
-                    kb.apply(e);
-                }
-                if self.opts.trace {
-                    self.trace.push(TraceItem::StepFinished {
-                        tick: self.tick,
-                        step: k,
-                    });
-                }
+            let eff = st.eff_end;
+            self.steps[ku].finished = true;
+            if self.step_running == Some(k) {
+                self.step_running = None;
+            }
+            if let (Some(e), Some(kb)) = (eff, self.kb.as_mut()) {
+                kb.apply(e);
+            }
+            if self.opts.trace {
+                self.trace.push(TraceItem::StepFinished {
+                    tick: self.tick,
+                    step: k,
+                });
             }
         }
         Status::Success
