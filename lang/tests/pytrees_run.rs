@@ -741,47 +741,34 @@ fn failure_exits_nonzero() {
 /// compiled and run to SUCCESS under py_trees with the goal reached.
 #[test]
 fn corpus_plans_run_to_success() {
-    let Some(ipc) = btc_testkit::corpus() else {
+    let Some(domains) = btc_testkit::corpus_rules() else {
         return;
     };
     if !btc_testkit::py_trees() {
         return;
     }
-    let root = repo_root();
-    let mut dirs: Vec<PathBuf> = std::fs::read_dir(root.join("tests/corpus_rules"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .collect();
-    dirs.sort();
     let mut ran = 0;
-    for dir in dirs {
-        let name = dir.file_name().unwrap().to_string_lossy().into_owned();
-        let rules_path = dir.join("rules.btrules");
-        let rules_text = std::fs::read_to_string(&rules_path).unwrap();
+    for d in domains {
+        let rules_text = std::fs::read_to_string(&d.rules).unwrap();
         let written = rules_text
             .lines()
             .find_map(|l| l.strip_prefix("domain \""))
             .unwrap()
             .trim_end_matches('"');
-        let corpus = ipc.join(&name);
-        let mut plans: Vec<PathBuf> = std::fs::read_dir(&corpus)
-            .unwrap()
-            .map(|e| e.unwrap().path())
-            .filter(|p| p.extension().is_some_and(|e| e == "plan" || e == "tplan"))
-            .collect();
-        plans.sort();
-        for plan in plans {
+        let dir = d.rules.parent().unwrap();
+        let name = &d.name;
+        for plan in &d.plans {
             let mut db = Database::new();
             let key = |p: &Path| btc_lang::path::FilePath::new(p);
             db.set_file(
                 &key(&dir.join(written)),
                 std::fs::read_to_string(dir.join(written)).unwrap(),
             );
-            let r = db.set_file(&key(&rules_path), rules_text.clone());
+            let r = db.set_file(&key(&d.rules), rules_text.clone());
             let stem = plan.file_stem().unwrap().to_string_lossy().into_owned();
-            let problem = corpus.join(format!("{stem}.pddl"));
+            let problem = d.corpus.join(format!("{stem}.pddl"));
             let p = db.set_file(&key(&problem), std::fs::read_to_string(&problem).unwrap());
-            let l = db.set_file(&key(&plan), std::fs::read_to_string(&plan).unwrap());
+            let l = db.set_file(&key(plan), std::fs::read_to_string(plan).unwrap());
             let job = CompileJob::new(&db, r, l, Some(p), None);
             let ir = compile(&db, job)
                 .clone()

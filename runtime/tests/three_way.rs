@@ -234,34 +234,20 @@ fn rules_fixtures_mean_the_same_in_every_executor() {
 
 #[test]
 fn corpus_plans_mean_the_same_in_every_executor() {
-    let Some(ipc) = btc_testkit::corpus() else {
+    let Some(domains) = btc_testkit::corpus_rules() else {
         return;
     };
     if !btc_testkit::py_trees() {
         return;
     }
-    let mut dirs: Vec<PathBuf> = std::fs::read_dir(root().join("tests/corpus_rules"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .collect();
-    dirs.sort();
     let mut ran = 0;
-    for dir in dirs {
-        let name = dir.file_name().unwrap().to_string_lossy().into_owned();
-        let rules = dir.join("rules.btrules");
-        let corpus = ipc.join(&name);
-        let mut plans: Vec<PathBuf> = std::fs::read_dir(&corpus)
-            .unwrap()
-            .map(|e| e.unwrap().path())
-            .filter(|p| p.extension().is_some_and(|e| e == "plan" || e == "tplan"))
-            .collect();
-        plans.sort();
-        for plan in plans {
+    for d in domains {
+        for plan in &d.plans {
             let stem = plan.file_stem().unwrap().to_string_lossy().into_owned();
-            let problem = corpus.join(format!("{stem}.pddl"));
-            let ex = common::load(&rules, &plan, &problem);
-            let o = three_ways(&ex, &format!("corpus_{name}_{stem}"));
-            assert!(o.goal_reached, "{name} {stem}");
+            let problem = d.corpus.join(format!("{stem}.pddl"));
+            let ex = common::load(&d.rules, plan, &problem);
+            let o = three_ways(&ex, &format!("corpus_{}_{stem}", d.name));
+            assert!(o.goal_reached, "{} {stem}", d.name);
             ran += 1;
         }
     }
