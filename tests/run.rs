@@ -23,6 +23,18 @@ fn plan_of(example: &str) -> String {
     format!("examples/{example}/{}", plans[0])
 }
 
+/// `btc run` of the ARIAC example with `extra` arguments.
+fn run_ariac(extra: &[&str]) -> Output {
+    let mut args = vec![
+        "run",
+        "examples/ariac/rules.btrules",
+        "--plan",
+        "examples/ariac/plan.txt",
+    ];
+    args.extend_from_slice(extra);
+    btc(&args)
+}
+
 /// `btc compile` of the ARIAC example to `out`, which must succeed.
 fn compile_ariac(emit: &str, out: &std::path::Path) {
     let done = btc(&[
@@ -69,14 +81,7 @@ fn every_example_runs_to_its_goal_and_exits_0() {
 
 #[test]
 fn the_text_summary_names_ticks_steps_and_the_goal() {
-    let out = btc(&[
-        "run",
-        "examples/ariac/rules.btrules",
-        "--plan",
-        "examples/ariac/plan.txt",
-        "--ticks-per-action",
-        "3",
-    ]);
+    let out = run_ariac(&["--ticks-per-action", "3"]);
     assert_eq!(out.status.code(), Some(0));
     let text = String::from_utf8_lossy(&out.stdout);
     // Four steps of one action each, three ticks per action plus the start.
@@ -88,14 +93,7 @@ fn the_text_summary_names_ticks_steps_and_the_goal() {
 
 #[test]
 fn a_fault_that_is_not_recovered_exits_1_with_its_record() {
-    let out = btc(&[
-        "run",
-        "examples/ariac/rules.btrules",
-        "--plan",
-        "examples/ariac/plan.txt",
-        "--faults",
-        "examples/ariac/faults/faulty_part.toml",
-    ]);
+    let out = run_ariac(&["--faults", "examples/ariac/faults/faulty_part.toml"]);
     assert_eq!(out.status.code(), Some(1));
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(
@@ -110,11 +108,7 @@ fn a_fault_that_is_not_recovered_exits_1_with_its_record() {
 
 #[test]
 fn a_recovered_fault_exits_0() {
-    let out = btc(&[
-        "run",
-        "examples/ariac/rules.btrules",
-        "--plan",
-        "examples/ariac/plan.txt",
+    let out = run_ariac(&[
         "--faults",
         "examples/ariac/faults/human_too_close.toml",
         "--format",
@@ -129,14 +123,7 @@ fn a_recovered_fault_exits_0() {
 fn the_trace_is_json_lines_of_status_changes_written_atomically() {
     let dir = tempfile::tempdir().unwrap();
     let trace = dir.path().join("trace.jsonl");
-    let out = btc(&[
-        "run",
-        "examples/ariac/rules.btrules",
-        "--plan",
-        "examples/ariac/plan.txt",
-        "--trace",
-        trace.to_str().unwrap(),
-    ]);
+    let out = run_ariac(&["--trace", trace.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(0));
     let text = std::fs::read_to_string(&trace).unwrap();
     let lines: Vec<serde_json::Value> = text
@@ -276,14 +263,7 @@ fn an_xml_tree_checks_step_preconditions_from_the_domain() {
 fn btlog_writes_a_groot2_replay_of_the_run() {
     let dir = tempfile::tempdir().unwrap();
     let log = dir.path().join("run.btlog");
-    let out = btc(&[
-        "run",
-        "examples/ariac/rules.btrules",
-        "--plan",
-        "examples/ariac/plan.txt",
-        "--btlog",
-        log.to_str().unwrap(),
-    ]);
+    let out = run_ariac(&["--btlog", log.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(0));
     let b = std::fs::read(&log).unwrap();
     assert_eq!(&b[..19], b"BTCPP4-FileLogger2\x01");
@@ -298,14 +278,7 @@ fn btlog_writes_a_groot2_replay_of_the_run() {
     // One 9-byte record per status change (the trace's), plus the root's
     // reset after the last tick.
     let trace = dir.path().join("run.jsonl");
-    btc(&[
-        "run",
-        "examples/ariac/rules.btrules",
-        "--plan",
-        "examples/ariac/plan.txt",
-        "--trace",
-        trace.to_str().unwrap(),
-    ]);
+    run_ariac(&["--trace", trace.to_str().unwrap()]);
     let changes = std::fs::read_to_string(&trace)
         .unwrap()
         .lines()
@@ -313,14 +286,7 @@ fn btlog_writes_a_groot2_replay_of_the_run() {
         .count();
     assert_eq!(b.len() - (31 + n), 9 * (changes + 1));
     // Groot2 opens only `.btlog` files.
-    let bad = btc(&[
-        "run",
-        "examples/ariac/rules.btrules",
-        "--plan",
-        "examples/ariac/plan.txt",
-        "--btlog",
-        "run.log",
-    ]);
+    let bad = run_ariac(&["--btlog", "run.log"]);
     assert_eq!(bad.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&bad.stderr).contains(".btlog"));
 }
