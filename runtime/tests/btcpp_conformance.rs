@@ -46,7 +46,8 @@ fn letter(s: Status) -> char {
     }
 }
 
-/// A case: its XML, how many ticks at most, simulated or real ms per tick.
+/// A case: its XML (or `file PATH`: a file both load, includes and all),
+/// how many ticks at most, simulated or real ms per tick.
 struct Case {
     xml: String,
     ticks: u32,
@@ -61,7 +62,7 @@ fn run_btc(case: &Case) -> Result<Run, String> {
 
 /// [`run_btc`], with the run's `.btlog` as btc writes it.
 fn run_btc_logged(case: &Case) -> Result<(Run, Vec<u8>), String> {
-    let doc = xml::parse(&case.xml).map_err(|e| e.to_string())?;
+    let doc = tree_doc(case)?;
     let opts = Options {
         trace: true,
         ms_per_tick: case.tick_ms.max(1),
@@ -115,6 +116,28 @@ fn run_btc_logged(case: &Case) -> Result<(Run, Vec<u8>), String> {
     let log = btc_runtime::btlog::write(&doc, &e, last, case.tick_ms.max(1), 0)
         .map_err(|e| e.to_string())?;
     Ok((run, log))
+}
+
+/// The case's tree as btc reads it: from the text, or from the file with
+/// the files it includes (relative to each file, as `btc run --tree`).
+fn tree_doc(case: &Case) -> Result<btc_runtime::TreeDoc, String> {
+    use btc_runtime::include::{self, Opened};
+    let Some(path) = case.xml.strip_prefix("file ") else {
+        return xml::parse(&case.xml).map_err(|e| e.to_string());
+    };
+    let path = std::path::Path::new(path.trim());
+    let read = |p: &std::path::Path| std::fs::read_to_string(p).map_err(|e| e.to_string());
+    let mut open = |p: &std::path::Path| -> Result<Opened<()>, String> {
+        Ok(Opened {
+            file: (),
+            text: read(p)?,
+        })
+    };
+    let first = Opened {
+        file: (),
+        text: read(path)?,
+    };
+    include::load(path, first, &mut open).map_err(|e| e.error.to_string())
 }
 
 // ------------------------------------------------------------- BT.CPP
@@ -763,6 +786,27 @@ fn where_btcpp_throws_on_a_skipped_condition_btc_fails_the_node() {
         let what = cpp.thrown.as_deref().expect("BT.CPP 4.10 throws");
         assert_eq!(cpp.ticks.len(), 1, "the first tick went through");
         compare_thrown(case, &run_btc(case).unwrap(), cpp, what).unwrap();
+    }
+}
+
+/// `<include path>` as BT.CPP reads it (`createTreeFromFile`, paths
+/// relative to each including file) and as btc does: the same statuses
+/// tick by tick.
+#[test]
+fn included_files_run_as_in_btcpp() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/include");
+    let case = |file: &str, ticks| Case {
+        xml: format!("file {}", dir.join(file).display()),
+        ticks,
+        tick_ms: 0,
+    };
+    let cases = [case("btcpp/main.xml", 12), case("main.xml", 3)];
+    check_all(&cases, "include");
+    // Both finish, the included trees' scripts counted as the fixture says.
+    if let Some(exe) = harness() {
+        for run in run_btcpp(&exe, &cases, "include-status") {
+            assert_eq!(run.unwrap().status, 'S');
+        }
     }
 }
 
