@@ -3,22 +3,15 @@
 //! ends); outputs keep their mode, owner, links and file type, whatever
 //! command writes them (`-o`, `plan -o`, `--trace`, `fmt`).
 
+mod support;
 use std::os::unix::fs::{FileTypeExt, MetadataExt, PermissionsExt};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::time::{Duration, Instant};
+use support::btc;
 
 fn repo() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn btc(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_btc"))
-        .args(args)
-        .env("NO_COLOR", "1")
-        .current_dir(repo())
-        .output()
-        .unwrap()
 }
 
 fn ariac(file: &str) -> String {
