@@ -292,17 +292,30 @@ fn item_key(item: &Item) -> String {
     }
 }
 
+/// The file's items as tracked structs. Items with the same head (many
+/// rules for one action) get keys made distinct by their occurrence:
+/// salsa finds a tracked struct by the hash of its key, so equal keys
+/// would all land in one bucket and make this quadratic in them.
 #[salsa::tracked(returns(ref))]
 pub fn rules_items(db: &dyn Db, file: SourceFile) -> Vec<RulesItem<'_>> {
+    let mut seen: std::collections::HashMap<String, u32> = std::collections::HashMap::new();
     parsed_rules(db, file)
         .items
         .iter()
-        .map(|n| RulesItem::new(db, file, item_key(&n.item), n.item.clone(), n.offset))
+        .map(|n| {
+            let mut key = item_key(&n.item);
+            let count = seen.entry(key.clone()).or_insert(0);
+            if *count > 0 {
+                key = format!("{key} #{count}");
+            }
+            *count += 1;
+            RulesItem::new(db, file, key, n.item.clone(), n.offset)
+        })
         .collect()
 }
 
 /// Resolves a path written in a rules file (relative to that file).
-fn resolve(db: &dyn Db, from: SourceFile, written: &str) -> Option<SourceFile> {
+pub(crate) fn resolve(db: &dyn Db, from: SourceFile, written: &str) -> Option<SourceFile> {
     let path = from.path(db).sibling(written)?;
     db.workspace().files(db).get(&path).copied()
 }
