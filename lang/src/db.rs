@@ -333,7 +333,7 @@ pub fn rules_items(db: &dyn Db, file: SourceFile) -> Vec<RulesItem<'_>> {
 }
 
 /// Resolves a path written in a rules file (relative to that file).
-fn resolve(db: &dyn Db, from: SourceFile, written: &str) -> Option<SourceFile> {
+pub(crate) fn resolve(db: &dyn Db, from: SourceFile, written: &str) -> Option<SourceFile> {
     let path = from.path(db).sibling(written)?;
     db.workspace().files(db).get(&path).copied()
 }
