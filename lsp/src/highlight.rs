@@ -62,7 +62,7 @@ pub fn classified(a: &Analysis) -> Vec<(Span, SemanticTokenType)> {
             out.push((*span, t));
         }
     }
-    for c in &a.syntax.tokens.comments {
+    for c in a.syntax.tokens.comments {
         out.push((c.span, SemanticTokenType::COMMENT));
     }
     out.sort_by_key(|(s, _)| s.start);

@@ -5,7 +5,7 @@
 
 use btc_lang::rules::ast::{Item, ItemNode, NamePart};
 use btc_lang::rules::check::Decls;
-use btc_lang::rules::lexer::{lex, Comment, Tok};
+use btc_lang::rules::lexer::{Comment, Tok};
 use btc_lang::rules::name::{find_folded, Key};
 use btc_pddl::source::Span;
 use btc_pddl::DomainIndex;
@@ -42,18 +42,18 @@ pub const OTHER_KEYWORDS: &[&str] = &[
     "backchained",
 ];
 
-/// The tokens of a file with absolute spans, and its comments.
-pub struct Tokens {
-    pub toks: Vec<(Tok, Span)>,
-    pub comments: Vec<Comment>,
+/// The tokens of a file with absolute spans, and its comments (lexed once
+/// per text by the database: `btc_lang::db::rules_tokens`).
+pub struct Tokens<'a> {
+    pub toks: &'a [(Tok, Span)],
+    pub comments: &'a [Comment],
 }
 
-impl Tokens {
-    pub fn new(text: &str) -> Tokens {
-        let l = lex(text, 0);
+impl<'a> Tokens<'a> {
+    pub fn of(t: &'a btc_lang::db::FileTokens) -> Tokens<'a> {
         Tokens {
-            toks: l.tokens,
-            comments: l.comments,
+            toks: &t.tokens,
+            comments: &t.comments,
         }
     }
 
@@ -213,7 +213,7 @@ pub enum Symbol {
 /// A file's tokens with its parsed items, for classification.
 pub struct FileSyntax<'a> {
     pub text: &'a str,
-    pub tokens: Tokens,
+    pub tokens: Tokens<'a>,
     pub items: &'a [ItemNode],
     /// Declarations visible in the file (its own and its imports').
     pub decls: &'a Decls,
@@ -385,7 +385,7 @@ impl FileSyntax<'_> {
             format!("{{{name}}}")
         };
         let mut out = Vec::new();
-        for (t, s) in &self.tokens.toks {
+        for (t, s) in self.tokens.toks {
             if s.start < start || s.end > end || !matches!(t, Tok::Str(_)) {
                 continue;
             }
