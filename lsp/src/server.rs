@@ -235,39 +235,47 @@ impl LanguageServer for Backend {
     }
 
     async fn did_open(&self, p: DidOpenTextDocumentParams) {
-        if let Some(path) = path_of(&p.text_document.uri) {
-            self.ws()
-                .open(&path, p.text_document.text, p.text_document.version);
-        }
+        // Notifications have no response to carry an error: a panic is
+        // dropped, and the server keeps serving.
+        let _ = isolated(|| {
+            if let Some(path) = path_of(&p.text_document.uri) {
+                self.ws()
+                    .open(&path, p.text_document.text, p.text_document.version);
+            }
+        });
         self.publish().await;
     }
 
     async fn did_change(&self, p: DidChangeTextDocumentParams) {
-        if let Some(path) = path_of(&p.text_document.uri) {
-            self.ws()
-                .change(&path, p.content_changes, p.text_document.version);
-        }
+        let _ = isolated(|| {
+            if let Some(path) = path_of(&p.text_document.uri) {
+                self.ws()
+                    .change(&path, p.content_changes, p.text_document.version);
+            }
+        });
         self.publish().await;
     }
 
     async fn did_save(&self, _: DidSaveTextDocumentParams) {}
 
     async fn did_close(&self, p: DidCloseTextDocumentParams) {
-        if let Some(path) = path_of(&p.text_document.uri) {
-            self.ws().close(&path);
-        }
+        let _ = isolated(|| {
+            if let Some(path) = path_of(&p.text_document.uri) {
+                self.ws().close(&path);
+            }
+        });
         self.publish().await;
     }
 
     async fn did_change_watched_files(&self, p: DidChangeWatchedFilesParams) {
-        {
+        let _ = isolated(|| {
             let mut ws = self.ws();
             for c in p.changes {
                 if let Some(path) = path_of(&c.uri) {
                     ws.changed_on_disk(&path);
                 }
             }
-        }
+        });
         self.publish().await;
     }
 
