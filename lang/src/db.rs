@@ -292,12 +292,25 @@ fn item_key(item: &Item) -> String {
     }
 }
 
+/// The file's items as tracked structs. Items with the same head (many
+/// rules for one action) get keys made distinct by their occurrence:
+/// salsa finds a tracked struct by the hash of its key, so equal keys
+/// would all land in one bucket and make this quadratic in them.
 #[salsa::tracked(returns(ref))]
 pub fn rules_items(db: &dyn Db, file: SourceFile) -> Vec<RulesItem<'_>> {
+    let mut seen: std::collections::HashMap<String, u32> = std::collections::HashMap::new();
     parsed_rules(db, file)
         .items
         .iter()
-        .map(|n| RulesItem::new(db, file, item_key(&n.item), n.item.clone(), n.offset))
+        .map(|n| {
+            let mut key = item_key(&n.item);
+            let count = seen.entry(key.clone()).or_insert(0);
+            if *count > 0 {
+                key = format!("{key} #{count}");
+            }
+            *count += 1;
+            RulesItem::new(db, file, key, n.item.clone(), n.offset)
+        })
         .collect()
 }
 
