@@ -705,10 +705,11 @@ impl<'db> JobWorld<'db> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    fn load(db: &mut Database, path: &str) -> SourceFile {
+    /// Loads a file of the repository under its repository-relative path.
+    pub(crate) fn load(db: &mut Database, path: &str) -> SourceFile {
         let full = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("..")
             .join(path);

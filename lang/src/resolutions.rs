@@ -193,14 +193,8 @@ fn site_of<'db>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::db::tests::load;
     use crate::db::Database;
-
-    fn load(db: &mut Database, path: &str) -> SourceFile {
-        let full = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("..")
-            .join(path);
-        db.set_file(path, std::fs::read_to_string(&full).unwrap())
-    }
 
     /// Each name of a file as `text -> target @ file:text-at-site`.
     fn described(db: &Database, f: SourceFile) -> Vec<String> {

@@ -214,7 +214,11 @@ pub fn capabilities() -> ServerCapabilities {
             },
         )),
         document_formatting_provider: Some(OneOf::Left(true)),
-        rename_provider: Some(OneOf::Left(true)),
+        rename_provider: Some(OneOf::Right(RenameOptions {
+            prepare_provider: Some(true),
+            work_done_progress_options: WorkDoneProgressOptions::default(),
+        })),
+        document_highlight_provider: Some(OneOf::Left(true)),
         inlay_hint_provider: Some(OneOf::Left(true)),
         code_action_provider: Some(CodeActionProviderCapability::Options(CodeActionOptions {
             code_action_kinds: Some(vec![CodeActionKind::QUICKFIX]),
@@ -263,39 +267,47 @@ impl LanguageServer for Backend {
     }
 
     async fn did_open(&self, p: DidOpenTextDocumentParams) {
-        if let Some(path) = path_of(&p.text_document.uri) {
-            self.ws()
-                .open(&path, p.text_document.text, p.text_document.version);
-        }
+        // Notifications have no response to carry an error: a panic is
+        // dropped, and the server keeps serving.
+        let _ = isolated(|| {
+            if let Some(path) = path_of(&p.text_document.uri) {
+                self.ws()
+                    .open(&path, p.text_document.text, p.text_document.version);
+            }
+        });
         self.publish().await;
     }
 
     async fn did_change(&self, p: DidChangeTextDocumentParams) {
-        if let Some(path) = path_of(&p.text_document.uri) {
-            self.ws()
-                .change(&path, p.content_changes, p.text_document.version);
-        }
+        let _ = isolated(|| {
+            if let Some(path) = path_of(&p.text_document.uri) {
+                self.ws()
+                    .change(&path, p.content_changes, p.text_document.version);
+            }
+        });
         self.publish().await;
     }
 
     async fn did_save(&self, _: DidSaveTextDocumentParams) {}
 
     async fn did_close(&self, p: DidCloseTextDocumentParams) {
-        if let Some(path) = path_of(&p.text_document.uri) {
-            self.ws().close(&path);
-        }
+        let _ = isolated(|| {
+            if let Some(path) = path_of(&p.text_document.uri) {
+                self.ws().close(&path);
+            }
+        });
         self.publish().await;
     }
 
     async fn did_change_watched_files(&self, p: DidChangeWatchedFilesParams) {
-        {
+        let _ = isolated(|| {
             let mut ws = self.ws();
             for c in p.changes {
                 if let Some(path) = path_of(&c.uri) {
                     ws.changed_on_disk(&path);
                 }
             }
-        }
+        });
         self.publish().await;
     }
 
@@ -314,8 +326,15 @@ impl LanguageServer for Backend {
         let pp = p.text_document_position_params;
         self.with_analysis(&pp.text_document.uri, |a| {
             let off = a.line_index().offset(pp.position);
-            let place = navigation::definition(a, off)?;
-            a.location(&place).map(GotoDefinitionResponse::Scalar)
+            let mut found: Vec<Location> = navigation::definition(a, off)
+                .iter()
+                .filter_map(|p| a.location(p))
+                .collect();
+            match found.len() {
+                0 => None,
+                1 => found.pop().map(GotoDefinitionResponse::Scalar),
+                _ => Some(GotoDefinitionResponse::Array(found)),
+            }
         })
     }
 
@@ -329,7 +348,7 @@ impl LanguageServer for Backend {
             Some(
                 places
                     .iter()
-                    .filter(|pl| include || Some(*pl) != def.as_ref())
+                    .filter(|pl| include || !def.contains(pl))
                     .filter_map(|pl| a.location(pl))
                     .collect(),
             )
@@ -392,6 +411,32 @@ impl LanguageServer for Backend {
             Some(Ok(edit)) => Ok(Some(edit)),
             Some(Err(e)) => Err(Error::invalid_params(e.0)),
         }
+    }
+
+    async fn prepare_rename(
+        &self,
+        p: TextDocumentPositionParams,
+    ) -> Result<Option<PrepareRenameResponse>> {
+        let r = self.with_analysis(&p.text_document.uri, |a| {
+            let off = a.line_index().offset(p.position);
+            Some(navigation::prepare_rename(a, off).map(|s| a.range(s)))
+        });
+        match r? {
+            None => Ok(None),
+            Some(Ok(range)) => Ok(Some(PrepareRenameResponse::Range(range))),
+            Some(Err(e)) => Err(Error::invalid_params(e.0)),
+        }
+    }
+
+    async fn document_highlight(
+        &self,
+        p: DocumentHighlightParams,
+    ) -> Result<Option<Vec<DocumentHighlight>>> {
+        let pp = p.text_document_position_params;
+        self.with_analysis(&pp.text_document.uri, |a| {
+            let off = a.line_index().offset(pp.position);
+            navigation::highlights(a, off)
+        })
     }
 
     async fn inlay_hint(&self, p: InlayHintParams) -> Result<Option<Vec<InlayHint>>> {
