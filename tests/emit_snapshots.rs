@@ -140,3 +140,53 @@ fn no_placeholder_reaches_a_btcpp_name_and_no_value_is_lost() {
         assert!(!text.contains("{newtons}"), "{text}");
     }
 }
+
+/// Scripts in the rules (`script` leaves, `[skip_if: ...]` and other pre-
+/// and post-conditions) through every emitter that can express them: BT.CPP
+/// attributes and `<Script>` leaves in both modes, the JSON IR's `scripts`;
+/// DOT and Mermaid do not show them. A py_trees module cannot run them:
+/// E001 at each script leaf and attribute.
+#[test]
+fn scripts_through_every_emitter_and_refused_for_py_trees() {
+    let rules = Path::new("tests/fixtures/scripts/rules.btrules");
+    for emit in EMITTERS.iter().filter(|e| **e != "pytrees") {
+        insta::assert_snapshot!(format!("scripts_{emit}"), compile(rules, emit, &[]));
+    }
+    let inline = compile(rules, "btcpp", &["--inline"]);
+    assert!(
+        inline.contains(r#"<MoveTo _onSuccess="moved += 1" robot="floor_robot" target="bin1"/>"#),
+        "{inline}"
+    );
+    insta::assert_snapshot!("scripts_btcpp_inline", inline);
+    let out = Command::new(env!("CARGO_BIN_EXE_btc"))
+        .arg("compile")
+        .arg(rules)
+        .args([
+            "--plan",
+            "tests/fixtures/scripts/plan.txt",
+            "--emit",
+            "pytrees",
+        ])
+        .env("NO_COLOR", "1")
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1), "py_trees must be refused");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    for key in [
+        "on_success",
+        "skip_if",
+        "failure_if",
+        "post",
+        "Script",
+        "ScriptCondition",
+    ] {
+        assert!(
+            stderr.contains(&format!(
+                "[E001] Error: a py_trees module cannot run `{key}`"
+            )),
+            "{key}:\n{stderr}"
+        );
+    }
+    insta::assert_snapshot!("scripts_pytrees_refused", stderr);
+}

@@ -431,3 +431,44 @@ fn a_step_redone_after_a_fault_re_establishes_its_effects() {
     );
     assert_eq!(s["goal_reached"], true);
 }
+
+/// Scripts written in the rules run in btc's engine: a `script` leaf sets
+/// an entry, `on_success` counts, `skip_if` lets one `Say` run and skips the
+/// other, `script_condition` and `failure_if` guard the grasp. The same
+/// commands come from the rules, the JSON IR and the BT.CPP XML in SubTree
+/// mode and inlined.
+#[test]
+fn scripts_in_the_rules_run_the_same_from_the_ir_and_the_xml() {
+    let dir = tempfile::tempdir().unwrap();
+    let rules = "tests/fixtures/scripts/rules.btrules";
+    let plan = "tests/fixtures/scripts/plan.txt";
+    let problem = "tests/fixtures/emit/values/problem.pddl";
+    let expected = commands_of(&["run", rules, "--plan", plan], "rules");
+    let said: Vec<&serde_json::Value> = expected
+        .iter()
+        .filter(|c| c[1] == "Say")
+        .map(|c| &c[2][0][1])
+        .collect();
+    assert_eq!(said, ["moved once"; 4], "{expected:?}");
+    assert_eq!(expected.iter().filter(|c| c[1] == "Grip").count(), 2);
+    for (what, emit, extra) in [
+        ("json", "json", None),
+        ("xml", "btcpp", None),
+        ("inlined xml", "btcpp", Some("--inline")),
+    ] {
+        let tree = dir.path().join(format!("tree_{emit}_{}", extra.is_some()));
+        let extra: Vec<&str> = extra.into_iter().collect();
+        compile(rules, plan, emit, &tree, &extra);
+        let got = commands_of(
+            &[
+                "run",
+                "--tree",
+                tree.to_str().unwrap(),
+                "--problem",
+                problem,
+            ],
+            what,
+        );
+        assert_eq!(got, expected, "{what}");
+    }
+}

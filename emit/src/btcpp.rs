@@ -156,6 +156,14 @@ impl Xml {
         self
     }
 
+    /// BT.CPP's pre- and post-condition attributes (`_skipIf="..."`).
+    fn scripts(&mut self, scripts: &NodeScripts) -> &mut Xml {
+        for (attr, text) in scripts.given() {
+            self.attr(attr, text);
+        }
+        self
+    }
+
     fn port(&mut self, p: &Port) -> &mut Xml {
         match &p.value {
             PortValue::Text(s) => self.attr(&p.name, s),
@@ -223,9 +231,10 @@ fn node(x: &mut Xml, n: &Node, ir: &TreeIr) {
             control,
             name,
             children,
+            scripts,
         } => {
             let tag = control_tag(*control);
-            x.open(tag).name(name);
+            x.open(tag).name(name).scripts(scripts);
             if let ControlKind::Parallel { success, failure } = control {
                 number(x, "success_count", success);
                 number(x, "failure_count", failure);
@@ -243,9 +252,10 @@ fn node(x: &mut Xml, n: &Node, ir: &TreeIr) {
             decorator,
             name,
             child,
+            scripts,
         } => {
             let tag = decorator_tag(decorator);
-            x.open(tag).name(name);
+            x.open(tag).name(name).scripts(scripts);
             match decorator {
                 DecoratorKind::Retry { times } => number(x, "num_attempts", times),
                 DecoratorKind::Repeat { times } => number(x, "num_cycles", times),
@@ -257,16 +267,20 @@ fn node(x: &mut Xml, n: &Node, ir: &TreeIr) {
             x.end(tag);
         }
         Node::Leaf {
-            id, name, ports, ..
+            id,
+            name,
+            ports,
+            scripts,
+            ..
         } => {
-            x.open(&element_name(id)).name(name);
+            x.open(&element_name(id)).name(name).scripts(scripts);
             for p in ports {
                 x.port(p);
             }
             x.close(true);
         }
-        Node::SubTree { id, ports } => {
-            x.open("SubTree").attr("ID", id);
+        Node::SubTree { id, ports, scripts } => {
+            x.open("SubTree").attr("ID", id).scripts(scripts);
             for p in ports {
                 x.port(p);
             }

@@ -88,6 +88,7 @@ fn flatten(root: &Node, ir: &TreeIr) -> Flat {
                 id,
                 name,
                 ports,
+                ..
             } => (
                 leaf_label(id, name, ports),
                 if *leaf == LeafKind::Condition {

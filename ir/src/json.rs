@@ -110,6 +110,7 @@ fn upgrade_node(n: Node) -> Result<Node, String> {
             id,
             name,
             mut ports,
+            scripts,
         } => {
             let key = match id.as_str() {
                 "KbHolds" => Some("formula"),
@@ -136,15 +137,18 @@ fn upgrade_node(n: Node) -> Result<Node, String> {
                 id,
                 name,
                 ports,
+                scripts,
             }
         }
         Node::Control {
             control,
             name,
             children,
+            scripts,
         } => Node::Control {
             control,
             name,
+            scripts,
             children: children
                 .into_iter()
                 .map(upgrade_node)
@@ -154,9 +158,11 @@ fn upgrade_node(n: Node) -> Result<Node, String> {
             decorator,
             name,
             child,
+            scripts,
         } => Node::Decorator {
             decorator,
             name,
+            scripts,
             child: Box::new(upgrade_node(*child)?),
         },
         Node::Step { step, child } => Node::Step {

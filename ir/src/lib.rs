@@ -17,8 +17,10 @@ use std::collections::HashSet;
 pub mod json;
 mod label;
 mod nodes;
+mod scripts;
 pub use label::{Label, LabelPart};
 pub use nodes::{ControlKind, Count, DecoratorKind};
+pub use scripts::NodeScripts;
 
 /// The version of the IR's JSON encoding (`"ir_version"`). Version 1 (PDDL
 /// as strings, no world) is still read: [`json::decode`].
@@ -83,20 +85,35 @@ pub enum Node {
         control: ControlKind,
         name: Option<Label>,
         children: Vec<Node>,
+        /// BT.CPP's pre- and post-condition scripts around the node.
+        #[serde(default, skip_serializing_if = "NodeScripts::is_empty")]
+        scripts: NodeScripts,
     },
     Decorator {
         decorator: DecoratorKind,
         name: Option<Label>,
         child: Box<Node>,
+        /// BT.CPP's pre- and post-condition scripts around the node.
+        #[serde(default, skip_serializing_if = "NodeScripts::is_empty")]
+        scripts: NodeScripts,
     },
     Leaf {
         leaf: LeafKind,
         id: String,
         name: Option<Label>,
         ports: Vec<Port>,
+        /// BT.CPP's pre- and post-condition scripts around the node.
+        #[serde(default, skip_serializing_if = "NodeScripts::is_empty")]
+        scripts: NodeScripts,
     },
     /// A call of a [`TreeDef`].
-    SubTree { id: String, ports: Vec<Port> },
+    SubTree {
+        id: String,
+        ports: Vec<Port>,
+        /// BT.CPP's pre- and post-condition scripts around the node.
+        #[serde(default, skip_serializing_if = "NodeScripts::is_empty")]
+        scripts: NodeScripts,
+    },
     /// The boundary of plan step `step` (0-based): its at-start effects apply
     /// when it starts, its at-end effects when `child` succeeds.
     Step { step: usize, child: Box<Node> },
@@ -108,6 +125,7 @@ impl Node {
             control: ControlKind::Sequence,
             name: None,
             children,
+            scripts: NodeScripts::default(),
         }
     }
 
@@ -334,8 +352,10 @@ impl TreeIr {
                 control,
                 name,
                 children,
+                scripts,
             } => Node::Control {
                 control: *control,
+                scripts: scripts.clone(),
                 name: name.as_ref().map(|s| s.fill(args)),
                 children: children
                     .iter()
@@ -346,7 +366,9 @@ impl TreeIr {
                 decorator,
                 name,
                 child,
+                scripts,
             } => Node::Decorator {
+                scripts: scripts.clone(),
                 decorator: match decorator.count() {
                     Some(Count::Param { param }) => match count_of(param, args) {
                         Some(c) => decorator.with_count(c),
@@ -362,8 +384,10 @@ impl TreeIr {
                 id,
                 name,
                 ports,
+                scripts,
             } => Node::Leaf {
                 leaf: *leaf,
+                scripts: scripts.clone(),
                 id: id.clone(),
                 name: name.as_ref().map(|s| s.fill(args)),
                 ports: subst(ports),
@@ -372,13 +396,27 @@ impl TreeIr {
                 step: *step,
                 child: Box::new(self.inline_node(child, args, depth, only)),
             },
-            Node::SubTree { id, ports } => match self.tree(id) {
+            Node::SubTree { id, ports, scripts } => match self.tree(id) {
                 Some(def) if depth < MAX_CALL_DEPTH && only.is_none_or(|ids| ids.contains(id)) => {
-                    self.inline_node(&def.root, &subst(ports), depth + 1, only)
+                    let root = self.inline_node(&def.root, &subst(ports), depth + 1, only);
+                    if scripts.is_empty() {
+                        root
+                    } else {
+                        // The call's scripts go around the whole subtree,
+                        // not merged into its root's own: a one-child
+                        // sequence returns, and halts, as its child does.
+                        Node::Control {
+                            control: ControlKind::Sequence,
+                            name: None,
+                            children: vec![root],
+                            scripts: scripts.clone(),
+                        }
+                    }
                 }
                 _ => Node::SubTree {
                     id: id.clone(),
                     ports: subst(ports),
+                    scripts: scripts.clone(),
                 },
             },
         }

@@ -172,8 +172,14 @@ fn expand_tree(decl: &TreeDecl, args: &[Arg]) -> Vec<Template> {
                 child: Box::new(template(child, arg)),
                 span: *span,
             },
-            Template::Call { name, args, span } => Template::Call {
+            Template::Call {
+                name,
+                args,
+                scripts,
+                span,
+            } => Template::Call {
                 name: name.clone(),
+                scripts: scripts.clone(),
                 args: args
                     .iter()
                     .map(|a| Arg {
@@ -404,6 +410,7 @@ impl Inst<'_> {
             } => {
                 let name = self.name(name);
                 vec![Node::Control {
+                    scripts: Default::default(),
                     control: *control,
                     name,
                     children: self.templates(children, steps),
@@ -425,12 +432,19 @@ impl Inst<'_> {
                     Node::sequence(kids)
                 };
                 vec![Node::Decorator {
+                    scripts: Default::default(),
                     decorator: kind,
                     name,
                     child: Box::new(child),
                 }]
             }
-            Template::Call { name, args, .. } => {
+            Template::Call {
+                name,
+                args,
+                scripts: attrs,
+                ..
+            } => {
+                let scripts = node_scripts(attrs);
                 if let Some(decl) = self.decls.trees.get(&name.text) {
                     // Declared trees expand at the call: BT.CPP cannot fill
                     // `{port}` inside a longer string, so a tree whose body
@@ -443,7 +457,17 @@ impl Inst<'_> {
                     self.depth += 1;
                     let nodes = self.templates(&body, steps);
                     self.depth -= 1;
-                    return nodes;
+                    if scripts.is_empty() {
+                        return nodes;
+                    }
+                    // The scripts go around the whole expanded body, as
+                    // they would around a <SubTree>.
+                    return vec![Node::Control {
+                        control: ControlKind::Sequence,
+                        name: None,
+                        children: nodes,
+                        scripts,
+                    }];
                 }
                 let ports: Vec<Port> = args
                     .iter()
@@ -458,16 +482,60 @@ impl Inst<'_> {
                     _ => LeafKind::Action,
                 };
                 vec![Node::Leaf {
+                    scripts,
                     leaf,
                     id: name.text.clone(),
                     name: None,
                     ports,
                 }]
             }
+            Template::Script {
+                condition, code, ..
+            } => {
+                let (leaf, id) = if *condition {
+                    (LeafKind::Condition, "ScriptCondition")
+                } else {
+                    (LeafKind::Action, "Script")
+                };
+                vec![Node::Leaf {
+                    leaf,
+                    id: id.into(),
+                    name: None,
+                    ports: vec![Port {
+                        name: "code".into(),
+                        value: PortValue::Text(script_code(code)),
+                    }],
+                    scripts: NodeScripts::default(),
+                }]
+            }
             Template::Steps { mode, .. } => steps(*mode),
             Template::Error { .. } => Vec::new(),
         }
     }
+}
+
+/// A call's `[key: "script"]` as BT.CPP's attributes (the checker has
+/// reported unknown keys and repeats: the first of each is kept).
+fn node_scripts(attrs: &[ScriptAttr]) -> NodeScripts {
+    let mut out = NodeScripts::default();
+    for a in attrs {
+        if let Some(k) = NodeScripts::key_index(&a.key.text) {
+            out.slot(k).get_or_insert_with(|| script_code(&a.code));
+        }
+    }
+    out
+}
+
+/// A script string's code (one that interpolates is reported; its text
+/// parts are kept).
+fn script_code(code: &StrLit) -> String {
+    code.parts
+        .iter()
+        .filter_map(|p| match p {
+            StrPart::Text { text } => Some(text.as_str()),
+            _ => None,
+        })
+        .collect()
 }
 
 /// A value as a decorator's count, when it is a whole number in range.
@@ -768,11 +836,13 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
         );
         info.rule = Some(rt.id.clone());
         let mut child = Node::SubTree {
+            scripts: Default::default(),
             id: rt.id.clone(),
             ports,
         };
         if let Some(over) = &info.pre_over_all {
             child = Node::Control {
+                scripts: Default::default(),
                 control: ControlKind::ReactiveSequence,
                 name: Some(format!("while {over}").into()),
                 children: vec![kb_holds(over.clone(), None), child],

@@ -7,7 +7,7 @@ use crate::db::{self, CompileJob, Db};
 use crate::rules::ast::{Item, RuleBody, Template};
 use crate::rules::name::Key;
 use crate::rules::parse::shift;
-use btc_ir::{Node, TreeIr};
+use btc_ir::{Node, NodeScripts, TreeIr};
 use btc_pddl::diagnostic::{codes, Diagnostic};
 use btc_pddl::source::Span;
 
@@ -46,6 +46,14 @@ const NOT_IN_PYTREES: &[Unsupported] = &[
     },
 ];
 
+/// A node's pre- and post-condition scripts (`[skip_if: "..."]`): the
+/// py_trees runtime runs no scripts around its behaviours.
+const SCRIPT_ATTRIBUTE: Unsupported = Unsupported {
+    id: "",
+    why: "is a BT.CPP script run around the node's tick; py_trees has no scripting language",
+    hint: "emit BT.CPP XML (`--emit btcpp`), or express the condition as a `condition` node in a `fallback` or `sequence`",
+};
+
 /// Why `target` cannot express the tree `ir` compiled from `job`: one
 /// diagnostic per place in the rules that uses something the target lacks
 /// (none when it can express all of it).
@@ -55,7 +63,8 @@ pub fn refusals(db: &dyn Db, job: CompileJob, ir: &TreeIr, target: Target) -> Ve
         .iter()
         .filter(|u| uses_leaf(ir, u.id))
         .collect();
-    if used.is_empty() {
+    let scripted = uses_scripts(ir);
+    if used.is_empty() && !scripted {
         return Vec::new();
     }
     let mut out = Vec::new();
@@ -70,14 +79,19 @@ pub fn refusals(db: &dyn Db, job: CompileJob, ir: &TreeIr, target: Target) -> Ve
             for t in templates(&node.item) {
                 calls(t, &mut found);
             }
-            for (name, span) in found {
-                let Some(u) = used.iter().find(|u| name == Key::new(u.id)) else {
-                    continue;
+            for (what, span) in found {
+                let (what, u) = match what {
+                    Use::Script(key) if scripted => (key, &SCRIPT_ATTRIBUTE),
+                    Use::Call(name) => match used.iter().find(|u| name == Key::new(u.id)) {
+                        Some(u) => (u.id, *u),
+                        None => continue,
+                    },
+                    Use::Script(_) => continue,
                 };
                 let d = Diagnostic::error(
                     codes::E_PYTREES_NODE,
                     span,
-                    format!("a py_trees module cannot run `{}`, which {}", u.id, u.why),
+                    format!("a py_trees module cannot run `{what}`, which {}", u.why),
                 )
                 .with_hint(u.hint);
                 out.push(shift(d, id, node.offset));
@@ -86,6 +100,25 @@ pub fn refusals(db: &dyn Db, job: CompileJob, ir: &TreeIr, target: Target) -> Ve
     }
     out.sort_by_key(|d| (d.span.file, d.span.start));
     out
+}
+
+/// Whether a node of the compiled tree has pre- or post-condition scripts.
+fn uses_scripts(ir: &TreeIr) -> bool {
+    let mut found = false;
+    let mut look = |n: &Node| {
+        found |= match n {
+            Node::Control { scripts, .. }
+            | Node::Decorator { scripts, .. }
+            | Node::Leaf { scripts, .. }
+            | Node::SubTree { scripts, .. } => !scripts.is_empty(),
+            Node::Step { .. } => false,
+        };
+    };
+    ir.root.walk(&mut look);
+    for t in &ir.trees {
+        t.root.walk(&mut look);
+    }
+    found
 }
 
 /// Whether a leaf `id` is in the compiled tree (the main tree or a rule's).
@@ -116,12 +149,38 @@ fn templates(item: &Item) -> &[Template] {
     }
 }
 
-/// Every call in a template (a leaf or a tree), with the span of its name.
-fn calls(t: &Template, out: &mut Vec<(Key, Span)>) {
+/// What a template uses that a target may lack.
+enum Use {
+    /// A leaf or tree, by name (`script` leaves as BT.CPP's `Script`).
+    Call(Key),
+    /// A pre- or post-condition, by its `.btrules` key.
+    Script(&'static str),
+}
+
+/// Every call and script attribute in a template, with the span of its
+/// name or attribute.
+fn calls(t: &Template, out: &mut Vec<(Use, Span)>) {
     match t {
         Template::Control { children, .. } => children.iter().for_each(|c| calls(c, out)),
         Template::Decorator { child, .. } => calls(child, out),
-        Template::Call { name, .. } => out.push((name.key.clone(), name.span)),
+        Template::Call { name, scripts, .. } => {
+            out.push((Use::Call(name.key.clone()), name.span));
+            for a in scripts {
+                if let Some(k) = NodeScripts::key_index(&a.key.text) {
+                    out.push((Use::Script(NodeScripts::KEYS[k]), a.span));
+                }
+            }
+        }
+        Template::Script {
+            condition, span, ..
+        } => {
+            let id = if *condition {
+                "ScriptCondition"
+            } else {
+                "Script"
+            };
+            out.push((Use::Call(Key::new(id)), *span));
+        }
         Template::Steps { .. } | Template::Error { .. } => {}
     }
 }

@@ -326,6 +326,7 @@ fn port(name: &str, value: PortValue) -> Port {
 
 fn leaf(kind: LeafKind, id: &str, name: Option<&str>, ports: Vec<Port>) -> Node {
     Node::Leaf {
+        scripts: Default::default(),
         leaf: kind,
         id: id.into(),
         name: name.map(Into::into),
@@ -424,6 +425,7 @@ fn hostile_ir() -> TreeIr {
         id: "rule \"'''\n".into(),
         params: vec!["x".into()],
         root: Node::Control {
+            scripts: Default::default(),
             control: ControlKind::ReactiveSequence,
             name: Some(Label {
                 parts: vec![
@@ -456,6 +458,7 @@ fn hostile_ir() -> TreeIr {
     let mut children = vec![Node::Step {
         step: 0,
         child: Box::new(Node::SubTree {
+            scripts: Default::default(),
             id: tree.id.clone(),
             ports: vec![port("x", text(OBJ_C))],
         }),
@@ -483,11 +486,13 @@ fn hostile_ir() -> TreeIr {
     children.push(Node::Step {
         step: 1,
         child: Box::new(Node::Decorator {
+            scripts: Default::default(),
             decorator: DecoratorKind::Retry {
                 times: btc_ir::Count::Fixed(2),
             },
             name: Some("retry \"'''\"".into()),
             child: Box::new(Node::Control {
+                scripts: Default::default(),
                 control: ControlKind::Parallel {
                     success: 2,
                     failure: 2,
@@ -520,6 +525,7 @@ fn hostile_ir() -> TreeIr {
         rules: String::new(),
         main_tree: "Main\"Tree".into(),
         root: Node::Control {
+            scripts: Default::default(),
             control: ControlKind::Sequence,
             name: Some("root \"\"\" ''' \\ \n </root> ü 日本".into()),
             children,
@@ -704,6 +710,7 @@ fn failure_exits_nonzero() {
     }
     let mut ir = hostile_ir();
     ir.root = Node::Control {
+        scripts: Default::default(),
         control: ControlKind::Sequence,
         name: None,
         children: vec![

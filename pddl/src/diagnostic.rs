@@ -333,6 +333,10 @@ pub mod codes {
         // Node palettes imported from BT.CPP XML (`import "nodes.xml"`)
         R_PALETTE = "R070", "an imported node palette that is not BT.CPP XML with a <TreeNodesModel>";
         R_PALETTE_TYPE = "R071", "a palette port whose C++ type btc cannot check";
+        // .btrules: BT.CPP scripts on nodes (`[skip_if: "..."]`, `script "..."`)
+        R_SCRIPT_KEY = "R120", "a script attribute on a node that is not one of BT.CPP's pre- or post-conditions";
+        R_SCRIPT_TWICE = "R121", "a node that gives the same pre- or post-condition twice";
+        R_SCRIPT_TEXT = "R122", "a script string that interpolates, which BT.CPP scripts cannot";
         // Emitting (btc compile --emit): what a target cannot express
         E_PYTREES_NODE = "E001", "a node a py_trees module cannot run as btc's engine does";
         // Running trees (btc run)

@@ -1,6 +1,7 @@
 //! A loaded tree before compilation: what the JSON IR and the XML loader
 //! both produce, so the two run through one builder (and give one trace).
 
+pub use btc_ir::NodeScripts;
 use btc_ir::{ControlKind, Count, DecoratorKind};
 use btc_ir::{LeafKind, Node, NodeModel, PortValue, StepInfo, TreeIr};
 
@@ -79,71 +80,6 @@ pub enum Verdict {
     Failure,
     Skipped,
     Running,
-}
-
-/// The scripts BT.CPP runs around any node's tick: preconditions
-/// (`_failureIf`, `_successIf`, `_skipIf`, `_while`, checked in that
-/// order) and post-conditions (`_onSuccess`, `_onFailure`, `_post`,
-/// `_onHalted`). Each is the script's text.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct NodeScripts {
-    pub failure_if: Option<String>,
-    pub success_if: Option<String>,
-    pub skip_if: Option<String>,
-    pub while_: Option<String>,
-    pub on_success: Option<String>,
-    pub on_failure: Option<String>,
-    pub post: Option<String>,
-    pub on_halted: Option<String>,
-}
-
-impl NodeScripts {
-    /// The attribute names, in BT.CPP's order.
-    pub const ATTRIBUTES: [&'static str; 8] = [
-        "_failureIf",
-        "_successIf",
-        "_skipIf",
-        "_while",
-        "_onSuccess",
-        "_onFailure",
-        "_post",
-        "_onHalted",
-    ];
-
-    /// The script of attribute `ATTRIBUTES[k]`.
-    pub fn slot(&mut self, k: usize) -> &mut Option<String> {
-        match k {
-            0 => &mut self.failure_if,
-            1 => &mut self.success_if,
-            2 => &mut self.skip_if,
-            3 => &mut self.while_,
-            4 => &mut self.on_success,
-            5 => &mut self.on_failure,
-            6 => &mut self.post,
-            _ => &mut self.on_halted,
-        }
-    }
-
-    /// The scripts given, with their attribute names, in BT.CPP's order.
-    pub fn given(&self) -> impl Iterator<Item = (&'static str, &str)> {
-        [
-            &self.failure_if,
-            &self.success_if,
-            &self.skip_if,
-            &self.while_,
-            &self.on_success,
-            &self.on_failure,
-            &self.post,
-            &self.on_halted,
-        ]
-        .into_iter()
-        .zip(NodeScripts::ATTRIBUTES)
-        .filter_map(|(s, a)| Some((a, s.as_deref()?)))
-    }
-
-    pub fn is_empty(&self) -> bool {
-        *self == NodeScripts::default()
-    }
 }
 
 /// A step's ground conditions, by when they are checked.
@@ -267,11 +203,13 @@ fn ports(ps: &[btc_ir::Port]) -> Vec<(String, PortValue)> {
 /// Converts an IR node; the IR nests at most a few dozen levels (its
 /// templates are written by hand), so recursion is fine here.
 pub fn from_node(n: &Node) -> SNode {
-    let (kind, name, children) = match n {
+    let none = NodeScripts::default();
+    let (kind, name, children, scripts) = match n {
         Node::Control {
             control,
             name,
             children,
+            scripts,
         } => (
             match control {
                 ControlKind::Sequence => Kind::Sequence,
@@ -285,11 +223,13 @@ pub fn from_node(n: &Node) -> SNode {
             },
             name.as_ref().map(ToString::to_string),
             children.iter().map(from_node).collect(),
+            scripts,
         ),
         Node::Decorator {
             decorator,
             name,
             child,
+            scripts,
         } => (
             match decorator {
                 DecoratorKind::Retry { times } => Kind::Retry(amount(times, clamp)),
@@ -301,12 +241,14 @@ pub fn from_node(n: &Node) -> SNode {
             },
             name.as_ref().map(ToString::to_string),
             vec![from_node(child)],
+            scripts,
         ),
         Node::Leaf {
             leaf,
             id,
             name,
             ports: ps,
+            scripts,
         } => (
             Kind::Leaf {
                 id: id.clone(),
@@ -315,8 +257,13 @@ pub fn from_node(n: &Node) -> SNode {
             },
             name.as_ref().map(ToString::to_string),
             Vec::new(),
+            scripts,
         ),
-        Node::SubTree { id, ports: ps } => (
+        Node::SubTree {
+            id,
+            ports: ps,
+            scripts,
+        } => (
             Kind::SubTree {
                 id: id.clone(),
                 ports: ports(ps),
@@ -324,6 +271,7 @@ pub fn from_node(n: &Node) -> SNode {
             },
             None,
             Vec::new(),
+            scripts,
         ),
         Node::Step { step, child } => (
             Kind::Step {
@@ -334,13 +282,14 @@ pub fn from_node(n: &Node) -> SNode {
             },
             None,
             vec![from_node(child)],
+            &none,
         ),
     };
     SNode {
         kind,
         name,
         children,
-        scripts: Default::default(),
+        scripts: scripts.clone(),
         at: None,
     }
 }

@@ -407,6 +407,7 @@ impl<'a> Emitter<'a> {
                 control,
                 name,
                 children,
+                ..
             } => {
                 let tag = match control {
                     ControlKind::Sequence => "Q",
@@ -432,6 +433,7 @@ impl<'a> Emitter<'a> {
                 decorator,
                 name,
                 child,
+                ..
             } => {
                 let (kind, count) = match decorator {
                     DecoratorKind::Retry { times } => ("retry", Some(times)),
@@ -465,7 +467,7 @@ impl<'a> Emitter<'a> {
                 self.node(child, o, indent);
                 o.push(')');
             }
-            Node::SubTree { id, ports } => match self.trees.get(id.as_str()) {
+            Node::SubTree { id, ports, .. } => match self.trees.get(id.as_str()) {
                 Some(&t) => {
                     let params = &self.ir.trees[t].params;
                     let positional = params.len() == ports.len()

@@ -11,6 +11,7 @@ use std::collections::BTreeSet;
 /// A KB leaf: `KbHolds(formula)` or `KbApply(effect)`.
 pub(super) fn kb_holds(f: Formula, name: Option<String>) -> Node {
     Node::Leaf {
+        scripts: Default::default(),
         leaf: LeafKind::Condition,
         id: "KbHolds".into(),
         name: name.map(Label::text),
@@ -106,6 +107,7 @@ pub(super) fn parallel(step_nodes: &[Option<Node>], infos: &[StepInfo]) -> Node 
                     let implied = prev.is_some_and(|p| p == i || precedes[p].contains(&i));
                     if !implied && !chain[..k].contains(&i) {
                         seq.push(Node::Leaf {
+                            scripts: Default::default(),
                             leaf: LeafKind::Action,
                             id: "WaitForStep".into(),
                             name: Some(format!("wait for step {}", i + 1).into()),
@@ -119,6 +121,7 @@ pub(super) fn parallel(step_nodes: &[Option<Node>], infos: &[StepInfo]) -> Node 
                 seq.push(step_nodes[j].clone().expect("filtered"));
             }
             Node::Control {
+                scripts: Default::default(),
                 control: ControlKind::Sequence,
                 name: None,
                 children: seq,
@@ -127,6 +130,7 @@ pub(super) fn parallel(step_nodes: &[Option<Node>], infos: &[StepInfo]) -> Node 
         .collect();
     let count = branches.len().max(1) as u32;
     Node::Control {
+        scripts: Default::default(),
         control: ControlKind::Parallel {
             success: count,
             failure: 1,

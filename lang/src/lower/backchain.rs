@@ -352,12 +352,14 @@ pub(super) fn stages(
             ));
         }
         out.push(Node::Control {
+            scripts: Default::default(),
             control: ControlKind::Fallback,
             name: Some(format!("step {label} {}", info.display()).into()),
             children: not_needed
                 .map(|f| kb_holds(f, Some(format!("step {label} not needed?"))))
                 .into_iter()
                 .chain([Node::Control {
+                    scripts: Default::default(),
                     control: ControlKind::Sequence,
                     name: None,
                     children: first

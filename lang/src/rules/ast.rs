@@ -452,6 +452,15 @@ pub struct Arg {
     pub value: Value,
 }
 
+/// A BT.CPP pre- or post-condition script on a node, `skip_if: "done"`
+/// in the brackets after a call; `key` is one of `NodeScripts::KEYS`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ScriptAttr {
+    pub key: Ident,
+    pub code: StrLit,
+    pub span: Span,
+}
+
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "lowercase")]
 pub enum Template {
@@ -472,6 +481,16 @@ pub enum Template {
     Call {
         name: Ident,
         args: Vec<Arg>,
+        /// `[skip_if: "...", on_success: "..."]` after the arguments.
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        scripts: Vec<ScriptAttr>,
+        span: Span,
+    },
+    /// `script "code"` (BT.CPP's `Script`) or `script_condition "code"`
+    /// (`ScriptCondition`).
+    Script {
+        condition: bool,
+        code: StrLit,
         span: Span,
     },
     Steps {
@@ -490,6 +509,7 @@ impl Template {
             Template::Control { span, .. }
             | Template::Decorator { span, .. }
             | Template::Call { span, .. }
+            | Template::Script { span, .. }
             | Template::Steps { span, .. }
             | Template::Error { span } => *span,
         }

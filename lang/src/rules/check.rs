@@ -8,6 +8,7 @@ use super::ast::*;
 use super::matching::Captures;
 use super::name::{capture_value, Key};
 use super::reach::{reach, Never, Verdict};
+use btc_ir::NodeScripts;
 use btc_pddl::ast::{Domain, Effect, Formula};
 use btc_pddl::check::{check_effect_in, check_formula_in, DomainIndex, ProblemIndex};
 use btc_pddl::diagnostic::{closest, codes, Diagnostic};
@@ -151,7 +152,16 @@ impl Tcx<'_> {
                 self.decorator_args(*decorator, args, *span);
                 self.template(child);
             }
-            Template::Call { name, args, span } => self.call(name, args, *span),
+            Template::Call {
+                name,
+                args,
+                scripts,
+                span,
+            } => {
+                self.call(name, args, *span);
+                self.script_attrs(scripts);
+            }
+            Template::Script { code, .. } => self.script_text(code),
             Template::Steps { span, .. } => {
                 if !self.in_plan {
                     self.err(
@@ -167,6 +177,57 @@ impl Tcx<'_> {
                 }
             }
             Template::Error { .. } => {}
+        }
+    }
+
+    /// A call's `[key: "script", ...]`: BT.CPP's attributes, each once.
+    fn script_attrs(&mut self, scripts: &[ScriptAttr]) {
+        let mut seen: Vec<&str> = Vec::new();
+        for a in scripts {
+            let key = a.key.text.as_str();
+            if NodeScripts::key_index(key).is_none() {
+                let mut d = Diagnostic::error(
+                    codes::R_SCRIPT_KEY,
+                    a.key.span,
+                    format!("`{key}` is not a pre- or post-condition BT.CPP runs around a node"),
+                );
+                d = match closest(key, NodeScripts::KEYS.iter().copied()) {
+                    Some(c) => d.with_hint(format!("did you mean `{c}`?")),
+                    None => d.with_hint(format!(
+                        "a node takes {}",
+                        NodeScripts::KEYS.map(|k| format!("`{k}`")).join(", ")
+                    )),
+                };
+                self.err(d);
+            } else if seen.contains(&key) {
+                self.err(
+                    Diagnostic::error(
+                        codes::R_SCRIPT_TWICE,
+                        a.key.span,
+                        format!("this node gives `{key}` twice"),
+                    )
+                    .with_hint("join the two scripts with `;` in one string"),
+                );
+            }
+            seen.push(key);
+            self.script_text(&a.code);
+        }
+    }
+
+    /// A script is BT.CPP code, passed through as written: `{...}` in it
+    /// would be a btc interpolation BT.CPP never sees.
+    fn script_text(&mut self, code: &StrLit) {
+        if code.plain().is_none() {
+            self.err(
+                Diagnostic::error(
+                    codes::R_SCRIPT_TEXT,
+                    code.span,
+                    "a script cannot interpolate `{...}`: it is BT.CPP code, run as written",
+                )
+                .with_hint(
+                    "read values from blackboard entries in the script, or write `\\{` for a brace",
+                ),
+            );
         }
     }
 

@@ -89,7 +89,7 @@ pub fn uses(item: &Item) -> ItemUses {
                 args.iter().for_each(|a| value(&a.value, out));
             }
             Template::Error { .. } => out.broken = true,
-            Template::Steps { .. } => {}
+            Template::Steps { .. } | Template::Script { .. } => {}
         }
     }
     let mut out = ItemUses::default();

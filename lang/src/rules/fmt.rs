@@ -296,12 +296,35 @@ fn decorator_head(d: DecoratorName, args: &[DecoratorArg]) -> String {
 /// A template that fits on one line: a call or `steps`.
 fn template_line(t: &Template) -> String {
     match t {
-        Template::Call { name, args, .. } => {
+        Template::Call {
+            name,
+            args,
+            scripts,
+            ..
+        } => {
             let a: Vec<String> = args
                 .iter()
                 .map(|a| format!("{}: {}", a.port.text, value(&a.value)))
                 .collect();
-            format!("{}({})", name.text, a.join(", "))
+            let mut line = format!("{}({})", name.text, a.join(", "));
+            if !scripts.is_empty() {
+                let s: Vec<String> = scripts
+                    .iter()
+                    .map(|s| format!("{}: {}", s.key.text, string(&s.code)))
+                    .collect();
+                line.push_str(&format!(" [{}]", s.join(", ")));
+            }
+            line
+        }
+        Template::Script {
+            condition, code, ..
+        } => {
+            let kw = if *condition {
+                "script_condition"
+            } else {
+                "script"
+            };
+            format!("{kw} {}", string(code))
         }
         Template::Steps { mode, .. } => match mode {
             StepsMode::InOrder => "steps".into(),

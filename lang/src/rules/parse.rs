@@ -723,6 +723,21 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
             .then_ignore(punct(":"))
             .then(value.clone())
             .map(|(port, value)| Arg { port, value });
+        let script_attr =
+            ident
+                .then_ignore(punct(":"))
+                .then(strlit)
+                .map_with(move |(key, code), e| ScriptAttr {
+                    key,
+                    code,
+                    span: sp(e.span()),
+                });
+        let script_attrs = script_attr
+            .separated_by(punct(","))
+            .allow_trailing()
+            .collect::<Vec<_>>()
+            .delimited_by(punct("["), punct("]"))
+            .labelled("scripts such as `[skip_if: \"done == true\"]`");
         let call = ident
             .then(
                 arg.separated_by(punct(","))
@@ -730,12 +745,23 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
                     .collect::<Vec<_>>()
                     .delimited_by(punct("("), punct(")")),
             )
-            .map_with(move |(name, args), e| Template::Call {
+            .then(script_attrs.or_not())
+            .map_with(move |((name, args), scripts), e| Template::Call {
                 name,
                 args,
+                scripts: scripts.unwrap_or_default(),
                 span: sp(e.span()),
             });
-        choice((steps, control, decorator, call))
+        // A node called `script(...)` is still a call: the leaf is the
+        // keyword followed by a string.
+        let script = choice((kw("script").to(false), kw("script_condition").to(true)))
+            .then(strlit)
+            .map_with(move |(condition, code), e| Template::Script {
+                condition,
+                code,
+                span: sp(e.span()),
+            });
+        choice((steps, control, decorator, script, call))
             .labelled("a node, a control such as `sequence`, or a decorator")
     });
 

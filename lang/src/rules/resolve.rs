@@ -397,7 +397,7 @@ impl Walk<'_> {
                     self.value(&a.value);
                 }
             }
-            Template::Steps { .. } | Template::Error { .. } => {}
+            Template::Steps { .. } | Template::Error { .. } | Template::Script { .. } => {}
         }
     }
 
