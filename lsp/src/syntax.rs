@@ -15,20 +15,8 @@ pub const DECL_KEYWORDS: &[&str] = &["action", "condition", "tree", "table"];
 
 pub use btc_lang::rules::parse::ITEM_KEYWORDS;
 
-pub const TEMPLATE_KEYWORDS: &[&str] = &[
-    "sequence",
-    "reactive_sequence",
-    "fallback",
-    "reactive_fallback",
-    "parallel",
-    "retry",
-    "repeat",
-    "timeout",
-    "inverter",
-    "force_success",
-    "force_failure",
-    "steps",
-];
+/// Node keywords (from the node vocabulary) and `steps`.
+pub use btc_lang::rules::parse::template_keywords;
 
 pub const OTHER_KEYWORDS: &[&str] = &[
     "effect",
@@ -353,7 +341,7 @@ impl FileSyntax<'_> {
                     });
                 }
                 if ITEM_KEYWORDS.contains(&name.as_str())
-                    || TEMPLATE_KEYWORDS.contains(&name.as_str())
+                    || template_keywords().any(|k| k == name.as_str())
                     || OTHER_KEYWORDS.contains(&name.as_str())
                 {
                     return Some(Symbol::Keyword);
