@@ -66,6 +66,8 @@ pub enum DecoratorKind {
     Inverter,
     ForceSuccess,
     ForceFailure,
+    Delay { ms: Count },
+    RunOnce,
 }
 
 /// A decorator's count or duration: a number, or (in a rule's tree, when
@@ -108,6 +110,8 @@ impl DecoratorKind {
             DecoratorKind::Inverter => DecoratorName::Inverter,
             DecoratorKind::ForceSuccess => DecoratorName::ForceSuccess,
             DecoratorKind::ForceFailure => DecoratorName::ForceFailure,
+            DecoratorKind::Delay { .. } => DecoratorName::Delay,
+            DecoratorKind::RunOnce => DecoratorName::RunOnce,
         }
     }
 
@@ -120,6 +124,8 @@ impl DecoratorKind {
             DecoratorName::Inverter => DecoratorKind::Inverter,
             DecoratorName::ForceSuccess => DecoratorKind::ForceSuccess,
             DecoratorName::ForceFailure => DecoratorKind::ForceFailure,
+            DecoratorName::Delay => DecoratorKind::Delay { ms: count },
+            DecoratorName::RunOnce => DecoratorKind::RunOnce,
         }
     }
 
@@ -135,7 +141,7 @@ impl DecoratorKind {
     pub fn count(&self) -> Option<&Count> {
         match self {
             DecoratorKind::Retry { times } | DecoratorKind::Repeat { times } => Some(times),
-            DecoratorKind::Timeout { ms } => Some(ms),
+            DecoratorKind::Timeout { ms } | DecoratorKind::Delay { ms } => Some(ms),
             _ => None,
         }
     }

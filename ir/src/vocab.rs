@@ -30,6 +30,8 @@ pub enum DecoratorName {
     Inverter,
     ForceSuccess,
     ForceFailure,
+    Delay,
+    RunOnce,
 }
 
 /// Which node an entry describes.
@@ -301,6 +303,38 @@ pub static NODES: &[NodeSpec] = &[
             class: "py_trees.decorators.SuccessIsFailure",
         },
         summary: "fails when its child finishes",
+    },
+    NodeSpec {
+        name: NodeName::Decorator(DecoratorName::Delay),
+        keyword: "delay",
+        tag: "Delay",
+        arity: Arity::One,
+        params: &[Param {
+            name: "msec",
+            port: "delay_msec",
+            ty: ParamType::Millis,
+            what: "milliseconds",
+            min: 1,
+            max: MILLIS_MAX,
+        }],
+        label: "delay {msec} ms",
+        pytrees: PyTrees::Built {
+            code: "delay",
+            class: "btc_runtime.Delay",
+        },
+        summary: "ticks its child once `msec` have passed since it started",
+    },
+    NodeSpec {
+        name: NodeName::Decorator(DecoratorName::RunOnce),
+        keyword: "run_once",
+        tag: "RunOnce",
+        arity: Arity::One,
+        params: &[],
+        label: "run once",
+        pytrees: PyTrees::NotExpressible {
+            why: "is SKIPPED after its child has run (BT.CPP `then_skip`), a status py_trees does not have",
+        },
+        summary: "runs its child to completion once; afterwards it is skipped",
     },
 ];
 
