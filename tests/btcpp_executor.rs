@@ -12,21 +12,14 @@
 //! generated nodes go into one executable (`all.cpp` below dispatches on
 //! the rule set's name), which takes the tree and the world as arguments.
 
+mod support;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
+use support::btc;
 
 fn repo() -> PathBuf {
     btc_testkit::repo()
-}
-
-fn btc(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_btc"))
-        .args(args)
-        .current_dir(repo())
-        .env("NO_COLOR", "1")
-        .output()
-        .unwrap()
 }
 
 fn ok(out: &Output, what: &str) {

@@ -1,17 +1,9 @@
 //! The CLI as a user meets it: several errors at once, hostile strings in
 //! outputs, atomic output files, and the design page's examples.
 
+mod support;
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn btc(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_btc"))
-        .args(args)
-        .env("NO_COLOR", "1")
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .unwrap()
-}
+use support::{btc, plan_of};
 
 #[test]
 fn check_reports_every_error_with_its_code_and_place() {
@@ -196,31 +188,10 @@ fn example_readmes_show_the_current_picture() {
             .nth(1)
             .and_then(|r| r.split("```").next())
             .expect("a mermaid picture");
-        let mut plans: Vec<_> = std::fs::read_dir(&dir)
-            .unwrap()
-            .map(|e| e.unwrap().path())
-            .filter(|p| {
-                p.file_name()
-                    .unwrap()
-                    .to_string_lossy()
-                    .starts_with("plan.")
-            })
-            .collect();
-        plans.sort();
-        let rel = |p: &Path| {
-            p.strip_prefix(env!("CARGO_MANIFEST_DIR"))
-                .unwrap()
-                .to_string_lossy()
-                .into_owned()
-        };
-        let out = btc(&[
-            "compile",
-            &rel(&dir.join("rules.btrules")),
-            "--plan",
-            &rel(&plans[0]),
-            "--emit",
-            "mermaid",
-        ]);
+        let name = dir.file_name().unwrap().to_string_lossy();
+        let rules = format!("examples/{name}/rules.btrules");
+        let plan = plan_of(&name);
+        let out = btc(&["compile", &rules, "--plan", &plan, "--emit", "mermaid"]);
         assert_eq!(
             shown,
             String::from_utf8_lossy(&out.stdout),

@@ -3,22 +3,15 @@
 //! ends); outputs keep their mode, owner, links and file type, whatever
 //! command writes them (`-o`, `plan -o`, `--trace`, `fmt`).
 
+mod support;
 use std::os::unix::fs::{FileTypeExt, MetadataExt, PermissionsExt};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::time::{Duration, Instant};
+use support::btc;
 
 fn repo() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn btc(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_btc"))
-        .args(args)
-        .env("NO_COLOR", "1")
-        .current_dir(repo())
-        .output()
-        .unwrap()
 }
 
 fn ariac(file: &str) -> String {
@@ -29,20 +22,29 @@ fn ariac(file: &str) -> String {
         .to_string()
 }
 
-/// Every input flag of every command, with `PATH` standing for the hostile
-/// input.
-fn input_commands() -> Vec<Vec<String>> {
-    let (r, d, p, l) = (
+/// The ARIAC example's rules, domain, problem and plan, and a trial.
+fn inputs() -> [String; 5] {
+    [
         ariac("rules.btrules"),
         ariac("domain.pddl"),
         ariac("problem.pddl"),
         ariac("plan.txt"),
-    );
-    let t = repo()
-        .join("examples/ariac_cell/trials/mixed.yaml")
-        .display()
-        .to_string();
-    let s = |v: &[&str]| v.iter().map(|x| x.to_string()).collect::<Vec<_>>();
+        repo()
+            .join("examples/ariac_cell/trials/mixed.yaml")
+            .display()
+            .to_string(),
+    ]
+}
+
+fn words(v: &[&str]) -> Vec<String> {
+    v.iter().map(|x| x.to_string()).collect()
+}
+
+/// Every input flag of every command, with `PATH` standing for the hostile
+/// input.
+fn input_commands() -> Vec<Vec<String>> {
+    let [r, d, p, l, t] = inputs();
+    let s = words;
     vec![
         s(&["check", "PATH"]),
         s(&["compile", "PATH", "--plan", &l, "--emit", "json"]),
@@ -128,17 +130,8 @@ fn fifo(dir: &Path, name: &str) -> PathBuf {
 
 /// Every command that writes a file, with `OUT` standing for the output.
 fn output_commands() -> Vec<Vec<String>> {
-    let (r, d, p, l) = (
-        ariac("rules.btrules"),
-        ariac("domain.pddl"),
-        ariac("problem.pddl"),
-        ariac("plan.txt"),
-    );
-    let t = repo()
-        .join("examples/ariac_cell/trials/mixed.yaml")
-        .display()
-        .to_string();
-    let s = |v: &[&str]| v.iter().map(|x| x.to_string()).collect::<Vec<_>>();
+    let [r, d, p, l, t] = inputs();
+    let s = words;
     vec![
         s(&["compile", &r, "--plan", &l, "--emit", "btcpp", "-o", "OUT"]),
         s(&["plan", &d, &p, "-o", "OUT", "--quiet"]),

@@ -2,17 +2,9 @@
 //! fault scenario (`examples/ariac/faults/`), checking the exit code, the
 //! number of replans, the plans and the final goal check.
 
+mod support;
 use serde_json::Value;
-use std::process::{Command, Output};
-
-fn btc(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_btc"))
-        .args(args)
-        .env("NO_COLOR", "1")
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .unwrap()
-}
+use support::btc;
 
 /// `btc run --replan --format json` on the ARIAC example with a problem
 /// file and a fault scenario (by name); the exit code and the summary.

@@ -1,27 +1,10 @@
 //! `btc run` as a user meets it: exit codes, the summary, the trace file,
 //! tree files, fault scenarios and the controller.
 
-use std::process::{Command, Output};
+mod support;
 
-fn btc(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_btc"))
-        .args(args)
-        .env("NO_COLOR", "1")
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .unwrap()
-}
-
-fn plan_of(example: &str) -> String {
-    let dir = format!("{}/examples/{example}", env!("CARGO_MANIFEST_DIR"));
-    let mut plans: Vec<String> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .filter(|n| n.starts_with("plan."))
-        .collect();
-    plans.sort();
-    format!("examples/{example}/{}", plans[0])
-}
+use std::process::Output;
+use support::{btc, btc_in, compile, exits, json_of, plan_of, summary_of};
 
 /// `btc run` of the ARIAC example with `extra` arguments.
 fn run_ariac(extra: &[&str]) -> Output {
@@ -37,27 +20,13 @@ fn run_ariac(extra: &[&str]) -> Output {
 
 /// `btc compile` of the ARIAC example to `out`, which must succeed.
 fn compile_ariac(emit: &str, out: &std::path::Path) {
-    let done = btc(&[
-        "compile",
+    compile(
         "examples/ariac/rules.btrules",
-        "--plan",
         "examples/ariac/plan.txt",
-        "--emit",
         emit,
-        "-o",
-        out.to_str().unwrap(),
-    ]);
-    assert_eq!(
-        done.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&done.stderr)
+        out,
+        &[],
     );
-}
-
-fn summary(out: &Output) -> serde_json::Value {
-    serde_json::from_slice(&out.stdout)
-        .unwrap_or_else(|e| panic!("{e}: {}", String::from_utf8_lossy(&out.stdout)))
 }
 
 #[test]
@@ -65,14 +34,7 @@ fn every_example_runs_to_its_goal_and_exits_0() {
     for ex in ["ariac", "nist_kitting", "p3_assembler", "two_robots"] {
         let rules = format!("examples/{ex}/rules.btrules");
         let plan = plan_of(ex);
-        let out = btc(&["run", &rules, "--plan", &plan, "--format", "json"]);
-        assert_eq!(
-            out.status.code(),
-            Some(0),
-            "{ex}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let s = summary(&out);
+        let s = summary_of(&["run", &rules, "--plan", &plan], 0);
         assert_eq!(s["status"], "SUCCESS", "{ex}");
         assert_eq!(s["goal_reached"], true, "{ex}");
         assert_eq!(s["steps_done"], s["steps_total"], "{ex}");
@@ -114,8 +76,8 @@ fn a_recovered_fault_exits_0() {
         "--format",
         "json",
     ]);
-    assert_eq!(out.status.code(), Some(0));
-    let s = summary(&out);
+    exits(&out, 0, "run --faults human_too_close");
+    let s = json_of(&out);
     assert_eq!(s["faults"][0]["ended"], "recovered");
 }
 
@@ -153,22 +115,17 @@ fn an_emitted_tree_runs_with_tree_and_the_problem() {
     for (fmt, ext) in [("btcpp", "xml"), ("json", "json")] {
         let tree = dir.path().join(format!("tree.{ext}"));
         compile_ariac(fmt, &tree);
-        let out = btc(&[
-            "run",
-            "--tree",
-            tree.to_str().unwrap(),
-            "--problem",
-            "examples/ariac/problem.pddl",
-            "--format",
-            "json",
-        ]);
-        assert_eq!(
-            out.status.code(),
-            Some(0),
-            "{fmt}: {}",
-            String::from_utf8_lossy(&out.stderr)
+        let s = summary_of(
+            &[
+                "run",
+                "--tree",
+                tree.to_str().unwrap(),
+                "--problem",
+                "examples/ariac/problem.pddl",
+            ],
+            0,
         );
-        assert_eq!(summary(&out)["goal_reached"], true);
+        assert_eq!(s["goal_reached"], true);
     }
 }
 
@@ -184,22 +141,16 @@ fn a_kb_tree_without_a_problem_is_refused() {
 
 #[test]
 fn the_controller_executes_each_command_once() {
-    let out = btc(&[
-        "run",
-        "examples/nist_kitting/rules.btrules",
-        "--plan",
-        &plan_of("nist_kitting"),
-        "--controller",
-        "--format",
-        "json",
-    ]);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    let s = summary_of(
+        &[
+            "run",
+            "examples/nist_kitting/rules.btrules",
+            "--plan",
+            &plan_of("nist_kitting"),
+            "--controller",
+        ],
+        0,
     );
-    let s = summary(&out);
     let cmds = s["commands"].as_array().unwrap();
     assert!(cmds.len() > 10);
     for (k, c) in cmds.iter().enumerate() {
@@ -220,17 +171,16 @@ fn usage_and_io_errors_exit_2() {
 
 #[test]
 fn a_tree_that_never_finishes_is_halted_after_max_ticks() {
-    let out = btc(&[
-        "run",
-        "--tree",
-        "tests/fixtures/run/forever.xml",
-        "--max-ticks",
-        "50",
-        "--format",
-        "json",
-    ]);
-    assert_eq!(out.status.code(), Some(1));
-    let s = summary(&out);
+    let s = summary_of(
+        &[
+            "run",
+            "--tree",
+            "tests/fixtures/run/forever.xml",
+            "--max-ticks",
+            "50",
+        ],
+        1,
+    );
     assert_eq!(s["status"], "RUNNING");
     assert_eq!(s["ticks"], 50);
     let reason = s["records"][0]["reason"].as_str().unwrap();
@@ -291,16 +241,6 @@ fn btlog_writes_a_groot2_replay_of_the_run() {
     assert!(String::from_utf8_lossy(&bad.stderr).contains(".btlog"));
 }
 
-/// `btc` with the working directory `dir`.
-fn btc_in(dir: &std::path::Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_btc"))
-        .args(args)
-        .env("NO_COLOR", "1")
-        .current_dir(dir)
-        .output()
-        .unwrap()
-}
-
 #[test]
 fn a_json_ir_carries_its_world_and_runs_from_its_own_folder() {
     let dir = tempfile::tempdir().unwrap();
@@ -311,22 +251,7 @@ fn a_json_ir_carries_its_world_and_runs_from_its_own_folder() {
         env!("CARGO_MANIFEST_DIR")
     );
     let tree = out_dir.join("p01.json");
-    let out = btc(&[
-        "compile",
-        &rules,
-        "--plan",
-        "examples/ariac/plan.txt",
-        "--emit",
-        "json",
-        "-o",
-        tree.to_str().unwrap(),
-    ]);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    compile(&rules, "examples/ariac/plan.txt", "json", &tree, &[]);
     let ir: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&tree).unwrap()).unwrap();
     assert_eq!(ir["ir_version"], 2);
@@ -349,13 +274,8 @@ fn a_json_ir_carries_its_world_and_runs_from_its_own_folder() {
         .ends_with("examples/ariac/plan.txt"));
     // `cd out && btc run --tree p01.json`: no PDDL file needed.
     let out = btc_in(&out_dir, &["run", "--tree", "p01.json", "--format", "json"]);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    assert_eq!(summary(&out)["goal_reached"], true);
+    exits(&out, 0, "run --tree p01.json");
+    assert_eq!(json_of(&out)["goal_reached"], true);
     // Even with the PDDL files gone.
     let moved = dir.path().join("elsewhere.json");
     std::fs::copy(&tree, &moved).unwrap();
@@ -363,12 +283,7 @@ fn a_json_ir_carries_its_world_and_runs_from_its_own_folder() {
         dir.path(),
         &["run", "--tree", "elsewhere.json", "--format", "json"],
     );
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    exits(&out, 0, "run --tree elsewhere.json");
 }
 
 #[test]
@@ -378,14 +293,7 @@ fn version_1_json_files_still_run() {
     // a backchained plan's `KbHolds` formulas as text ports.
     for file in ["ariac", "workshop_backchained"] {
         let tree = format!("tests/fixtures/ir_v1/{file}.json");
-        let out = btc(&["run", "--tree", &tree, "--format", "json"]);
-        assert_eq!(
-            out.status.code(),
-            Some(0),
-            "{file}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let s = summary(&out);
+        let s = summary_of(&["run", "--tree", &tree], 0);
         assert_eq!(s["goal_reached"], true, "{file}");
         assert_eq!(s["steps_done"], s["steps_total"], "{file}");
     }
@@ -404,18 +312,13 @@ fn version_1_json_files_still_run() {
         .replace("examples/ariac/domain.pddl", "domain.pddl")
         .replace("examples/ariac/problem.pddl", "problem.pddl");
     std::fs::write(dir.path().join("v1.json"), text).unwrap();
-    let out = btc(&[
-        "run",
-        "--tree",
-        dir.path().join("v1.json").to_str().unwrap(),
-        "--format",
-        "json",
-    ]);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    summary_of(
+        &[
+            "run",
+            "--tree",
+            dir.path().join("v1.json").to_str().unwrap(),
+        ],
+        0,
     );
 }
 
@@ -423,15 +326,8 @@ fn version_1_json_files_still_run() {
 /// commands it sends its controller, as (step, command, args).
 fn commands_of(args: &[&str], what: &str) -> Vec<serde_json::Value> {
     let mut all = args.to_vec();
-    all.extend(["--controller", "--format", "json"]);
-    let out = btc(&all);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{what}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let s = summary(&out);
+    all.push("--controller");
+    let s = summary_of(&all, 0);
     assert_eq!(s["goal_reached"], true, "{what}");
     s["commands"]
         .as_array()
@@ -470,18 +366,8 @@ fn computed_values_reach_the_engine_from_the_ir_and_from_the_xml() {
         ("inlined xml", "btcpp", Some("--inline")),
     ] {
         let tree = dir.path().join(format!("tree_{emit}_{}", extra.is_some()));
-        let mut args = vec![
-            "compile",
-            rules,
-            "--plan",
-            plan,
-            "--emit",
-            emit,
-            "-o",
-            tree.to_str().unwrap(),
-        ];
-        args.extend(extra);
-        assert_eq!(btc(&args).status.code(), Some(0), "{what}");
+        let extra: Vec<&str> = extra.into_iter().collect();
+        compile(rules, plan, emit, &tree, &extra);
         let got = commands_of(
             &[
                 "run",
@@ -500,20 +386,11 @@ fn computed_values_reach_the_engine_from_the_ir_and_from_the_xml() {
 fn an_xml_tree_runs_with_the_trees_it_includes() {
     // main.xml includes parts/pick.xml, which includes ../count.xml; run
     // from another folder, the paths stay relative to each file.
-    let out = btc(&[
-        "run",
-        "--tree",
-        "runtime/tests/fixtures/include/main.xml",
-        "--format",
-        "json",
-    ]);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    let s = summary_of(
+        &["run", "--tree", "runtime/tests/fixtures/include/main.xml"],
+        0,
     );
-    assert_eq!(summary(&out)["status"], "SUCCESS");
+    assert_eq!(s["status"], "SUCCESS");
 }
 
 /// A fault undoes a finished step's work (the part slips out of the
@@ -524,49 +401,33 @@ fn an_xml_tree_runs_with_the_trees_it_includes() {
 fn a_step_redone_after_a_fault_re_establishes_its_effects() {
     let rules = "tests/fixtures/run/redo/rules.btrules";
     let fault = "examples/ariac/faults/dropped_part.toml";
-    let out = btc(&[
-        "run",
-        rules,
-        "--plan",
-        "examples/ariac/plan.txt",
-        "--faults",
-        fault,
-        "--format",
-        "json",
-    ]);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stdout)
+    let s = summary_of(
+        &[
+            "run",
+            rules,
+            "--plan",
+            "examples/ariac/plan.txt",
+            "--faults",
+            fault,
+        ],
+        0,
     );
-    let s = summary(&out);
     assert_eq!(s["goal_reached"], true);
     assert_eq!(s["faults"][0]["ended"], "recovered", "{s}");
     let dir = tempfile::tempdir().unwrap();
     let tree = dir.path().join("tree.xml");
-    let done = btc(&[
-        "compile",
-        rules,
-        "--plan",
-        "examples/ariac/plan.txt",
-        "--emit",
-        "btcpp",
-        "-o",
-        tree.to_str().unwrap(),
-    ]);
-    assert_eq!(done.status.code(), Some(0));
-    let out = btc(&[
-        "run",
-        "--tree",
-        tree.to_str().unwrap(),
-        "--problem",
-        "examples/ariac/problem.pddl",
-        "--faults",
-        fault,
-        "--format",
-        "json",
-    ]);
-    assert_eq!(out.status.code(), Some(0));
-    assert_eq!(summary(&out)["goal_reached"], true);
+    compile(rules, "examples/ariac/plan.txt", "btcpp", &tree, &[]);
+    let s = summary_of(
+        &[
+            "run",
+            "--tree",
+            tree.to_str().unwrap(),
+            "--problem",
+            "examples/ariac/problem.pddl",
+            "--faults",
+            fault,
+        ],
+        0,
+    );
+    assert_eq!(s["goal_reached"], true);
 }

@@ -26,7 +26,10 @@ fuzz_target!(|data: &[u8]| {
         return;
     };
     for inline in [false, true] {
-        let options = btc_emit::Options { inline, node_module: None };
+        let options = btc_emit::Options {
+            inline,
+            ..btc_emit::Options::default()
+        };
         let xml = btc_emit::emit(ir, btc_emit::Format::Btcpp, &options);
         let mut reader = quick_xml::Reader::from_str(&xml);
         loop {
@@ -37,7 +40,10 @@ fuzz_target!(|data: &[u8]| {
             }
         }
         if let Err(e) = btc_runtime::load_tree(&xml) {
-            panic!("the runtime cannot load btc's own XML: {}\n{xml}", e.message);
+            panic!(
+                "the runtime cannot load btc's own XML: {}\n{xml}",
+                e.message
+            );
         }
     }
     let options = btc_emit::Options::default();
@@ -51,11 +57,17 @@ fuzz_target!(|data: &[u8]| {
         let name = format!("{:016x}.py", fxhash(py.as_bytes()));
         let _ = std::fs::write(std::path::Path::new(&dir).join(name), &py);
     }
-    for f in [btc_emit::Format::Dot, btc_emit::Format::Mermaid, btc_emit::Format::Commands] {
+    for f in [
+        btc_emit::Format::Dot,
+        btc_emit::Format::Mermaid,
+        btc_emit::Format::Commands,
+    ] {
         let _ = btc_emit::emit(ir, f, &options);
     }
 });
 
 fn fxhash(b: &[u8]) -> u64 {
-    b.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &x| (h ^ x as u64).wrapping_mul(0x100_0000_01b3))
+    b.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &x| {
+        (h ^ x as u64).wrapping_mul(0x100_0000_01b3)
+    })
 }

@@ -5,10 +5,10 @@
 
 use std::sync::OnceLock;
 
-use btc_pddl::{self as pddl, Document};
 use btc_pddl::pipeline::{domain_unit, DomainUnit};
 use btc_pddl::render::to_terminal;
 use btc_pddl::source::{decode, Sources};
+use btc_pddl::{self as pddl, Document};
 use libfuzzer_sys::fuzz_target;
 
 const DOMAIN_PATH: &str = "examples/ariac/domain.pddl";

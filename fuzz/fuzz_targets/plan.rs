@@ -5,7 +5,9 @@
 
 use std::sync::OnceLock;
 
-use btc_pddl::pipeline::{domain_unit, plan_unit, problem_unit, validate_units, DomainUnit, ProblemUnit};
+use btc_pddl::pipeline::{
+    domain_unit, plan_unit, problem_unit, validate_units, DomainUnit, ProblemUnit,
+};
 use btc_pddl::render::to_terminal;
 use btc_pddl::source::{decode, Sources};
 use libfuzzer_sys::fuzz_target;

@@ -2,39 +2,43 @@
 //! load, build the engine against the ARIAC world, tick a bounded run.
 #![no_main]
 
-use btc_pddl::pipeline::{domain_unit, problem_unit, DomainUnit, ProblemUnit};
-use btc_pddl::source::{decode, Sources};
-use btc_runtime::{Engine, Kb, Options};
+#[path = "common/ariac.rs"]
+mod ariac;
+
+use btc_pddl::source::decode;
+use btc_pddl::state::World;
+use btc_runtime::{Engine, Kb, Loaded, Options, TreeDoc};
 use libfuzzer_sys::fuzz_target;
-use std::sync::OnceLock;
-
-const DOMAIN: &str = include_str!("../../examples/ariac/domain.pddl");
-const PROBLEM: &str = include_str!("../../examples/ariac/problem.pddl");
-
-fn ariac() -> &'static (DomainUnit, ProblemUnit) {
-    static UNITS: OnceLock<(DomainUnit, ProblemUnit)> = OnceLock::new();
-    UNITS.get_or_init(|| {
-        let mut s = Sources::new();
-        s.add("domain.pddl", DOMAIN);
-        s.add("problem.pddl", PROBLEM);
-        let d = domain_unit(&s, 0);
-        let p = problem_unit(&s, 1, &d);
-        (d, p)
-    })
-}
 
 fuzz_target!(|data: &[u8]| {
     let (text, _) = decode(data);
-    let Ok((doc, _)) = btc_runtime::load_tree(&text) else {
+    let Ok(loaded) = btc_runtime::load_tree(&text) else {
         return;
     };
-    let (d, p) = ariac();
-    let Ok(world) = btc_pddl::state::World::of_checked(d.domain.as_ref().unwrap(), &d.index, p.problem.as_ref().unwrap(), &p.index) else {
+    // As `btc run --tree` does: a current IR runs in the world it carries,
+    // XML and a version-1 IR in the ARIAC world.
+    let Some(ariac) = ariac::world() else {
         return;
     };
-    let kb = Kb::new(&world);
-    let opts = Options { trace: true, ..Options::default() };
-    if let Ok(mut e) = Engine::build(&doc, Some(kb), opts) {
+    let (doc, own) = match loaded {
+        Loaded::Xml(doc) => match &ariac::units().0.domain {
+            Some(d) => (doc.with_actions(d), None),
+            None => return,
+        },
+        Loaded::Ir(ir) => (TreeDoc::from_ir(&ir), World::new(ir.world.clone()).ok()),
+        Loaded::IrV1(v1) => match v1.upgrade(ariac.model().clone()) {
+            Ok(ir) => (TreeDoc::from_ir(&ir), None),
+            Err(_) => return,
+        },
+    };
+    let world = own.as_ref().unwrap_or(&ariac);
+    let kb = Kb::new(world);
+    let opts = Options {
+        trace: true,
+        ..Options::default()
+    };
+    let built = Engine::build(&doc, Some(kb), opts);
+    if let Ok(mut e) = built {
         e.run(200, |e| {
             let _ = e.drain_trace(&mut std::io::sink());
         });

@@ -38,7 +38,12 @@ fuzz_target!(|data: &[u8]| {
         let tp = TrialProblem::build(cell, &t, "fuzz");
         let pf = db.set_file("trial.problem.pddl", tp.text.clone());
         let pid = db::file_id(&db, pf);
-        let pu = problem_unit_from(&tp.text, pid, cell.domain.domain.as_ref(), &cell.domain.index);
+        let pu = problem_unit_from(
+            &tp.text,
+            pid,
+            cell.domain.domain.as_ref(),
+            &cell.domain.index,
+        );
         diags.extend(pu.diagnostics);
     }
     if let Err(more) = CellSpec::parse(&text, fid) {

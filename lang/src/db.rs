@@ -228,6 +228,24 @@ pub fn parsed_rules(db: &dyn Db, file: SourceFile) -> ParsedRules {
     })
 }
 
+/// A rules file's tokens and comments (spans in file 0: positions, not
+/// places), lexed once per text: every language server request reads
+/// them, and lexing a huge file per request cost a large part of each.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FileTokens {
+    pub tokens: Vec<(crate::rules::lexer::Tok, Span)>,
+    pub comments: Vec<crate::rules::lexer::Comment>,
+}
+
+#[salsa::tracked(returns(ref))]
+pub fn rules_tokens(db: &dyn Db, file: SourceFile) -> FileTokens {
+    let l = crate::rules::lexer::lex(file.text(db), 0);
+    FileTokens {
+        tokens: l.tokens,
+        comments: l.comments,
+    }
+}
+
 /// Whether an imported file is a BT.CPP node palette (`.xml`) rather than
 /// rules.
 pub fn is_palette(path: &FilePath) -> bool {
@@ -292,17 +310,30 @@ fn item_key(item: &Item) -> String {
     }
 }
 
+/// The file's items as tracked structs. Items with the same head (many
+/// rules for one action) get keys made distinct by their occurrence:
+/// salsa finds a tracked struct by the hash of its key, so equal keys
+/// would all land in one bucket and make this quadratic in them.
 #[salsa::tracked(returns(ref))]
 pub fn rules_items(db: &dyn Db, file: SourceFile) -> Vec<RulesItem<'_>> {
+    let mut seen: std::collections::HashMap<String, u32> = std::collections::HashMap::new();
     parsed_rules(db, file)
         .items
         .iter()
-        .map(|n| RulesItem::new(db, file, item_key(&n.item), n.item.clone(), n.offset))
+        .map(|n| {
+            let mut key = item_key(&n.item);
+            let count = seen.entry(key.clone()).or_insert(0);
+            if *count > 0 {
+                key = format!("{key} #{count}");
+            }
+            *count += 1;
+            RulesItem::new(db, file, key, n.item.clone(), n.offset)
+        })
         .collect()
 }
 
 /// Resolves a path written in a rules file (relative to that file).
-fn resolve(db: &dyn Db, from: SourceFile, written: &str) -> Option<SourceFile> {
+pub(crate) fn resolve(db: &dyn Db, from: SourceFile, written: &str) -> Option<SourceFile> {
     let path = from.path(db).sibling(written)?;
     db.workspace().files(db).get(&path).copied()
 }
@@ -674,10 +705,11 @@ impl<'db> JobWorld<'db> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    fn load(db: &mut Database, path: &str) -> SourceFile {
+    /// Loads a file of the repository under its repository-relative path.
+    pub(crate) fn load(db: &mut Database, path: &str) -> SourceFile {
         let full = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("..")
             .join(path);

@@ -11,5 +11,6 @@ pub mod declared;
 pub mod lower;
 pub mod path;
 pub mod project;
+pub mod resolutions;
 pub mod rules;
 pub mod targets;

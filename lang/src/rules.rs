@@ -11,6 +11,7 @@ pub mod name;
 pub mod palette;
 pub mod parse;
 pub mod reach;
+pub mod resolve;
 pub mod skip;
 
 pub use ast::*;

@@ -6,10 +6,11 @@ use crate::syntax::FileSyntax;
 use crate::syntax::Tokens;
 use crate::workspace::Workspace;
 use btc_lang::db::{
-    action_index, checked_domain, declarations, import_closure, parsed_rules, rule_var_types,
-    rules_items, SourceFile,
+    action_index, checked_domain, declarations, parsed_rules, rule_var_types, rules_items,
+    SourceFile,
 };
 use btc_lang::path::FilePath;
+use btc_lang::resolutions::{item_resolutions, Resolved, Site};
 use btc_lang::rules::ast::{Item, ItemNode, Rule};
 use btc_lang::rules::check::{matched_actions, Decls};
 use btc_pddl::ast::{Action, Domain};
@@ -60,10 +61,8 @@ impl<'a> Analysis<'a> {
             domain,
             syntax: FileSyntax {
                 text,
-                tokens: Tokens::new(text),
+                tokens: Tokens::of(btc_lang::db::rules_tokens(db, file)),
                 items,
-                decls,
-                dix: domain.map(|d| d.2),
             },
             lines: std::cell::OnceCell::new(),
         })
@@ -123,34 +122,44 @@ impl<'a> Analysis<'a> {
             .unwrap_or_default()
     }
 
-    /// Files in scope: this one and its imports.
-    pub fn closure(&self) -> &'a [SourceFile] {
-        &import_closure(&self.ws.db, self.file).0
+    /// The names the checker resolved at a byte offset (the name under
+    /// the cursor, or the one ending at it), with their absolute spans.
+    /// Several when one name refers to several things (a pattern that
+    /// matches several actions).
+    pub fn names_at(&self, offset: usize) -> Vec<(Span, &'a Resolved<'a>)> {
+        let o = offset as u32;
+        let Some(k) = self.syntax.item_at(o) else {
+            return Vec::new();
+        };
+        let all: Vec<(Span, &'a Resolved<'a>)> = self.names_of(k).collect();
+        // Inside a name first; then a name that ends at the cursor.
+        let inside: Vec<_> = all
+            .iter()
+            .filter(|(s, _)| s.start <= o && o < s.end)
+            .copied()
+            .collect();
+        if !inside.is_empty() {
+            return inside;
+        }
+        all.into_iter().filter(|(s, _)| s.end == o).collect()
     }
 
-    /// The declaration of a node, tree or table named `name` (`table` says
-    /// which namespace), in this file or an import.
-    pub fn declaration(&self, name: &str, table: bool) -> Option<(Place, &'a Item)> {
-        for f in self.closure() {
-            for n in &parsed_rules(&self.ws.db, *f).items {
-                let found = match &n.item {
-                    Item::Node(d) if !table && d.name.text == name => Some(d.name.span),
-                    Item::Tree(d) if !table && d.name.text == name => Some(d.name.span),
-                    Item::Table(d) if table && d.name.text == name => Some(d.name.span),
-                    _ => None,
-                };
-                if let Some(s) = found {
-                    return Some((
-                        Place {
-                            file: *f,
-                            span: shift(s, n.offset),
-                        },
-                        &n.item,
-                    ));
-                }
-            }
+    /// The resolved names of item `k`, with absolute spans.
+    pub fn names_of(&self, k: usize) -> impl Iterator<Item = (Span, &'a Resolved<'a>)> + 'a {
+        let db = &self.ws.db;
+        let item = rules_items(db, self.file).get(k).copied();
+        let offset = self.items.get(k).map_or(0, |n| n.offset);
+        item.into_iter()
+            .flat_map(move |it| item_resolutions(db, it).iter())
+            .map(move |r| (shift(r.span, offset), r))
+    }
+
+    /// Where a declaration is, as a place.
+    pub fn place(&self, site: Site) -> Place {
+        Place {
+            file: site.file(&self.ws.db),
+            span: site.span(&self.ws.db),
         }
-        None
     }
 
     /// The source text of an item declared in `file` at `span` (item

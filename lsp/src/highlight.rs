@@ -1,10 +1,12 @@
 //! Semantic tokens and inlay hints.
 
 use crate::analysis::{shift, Analysis};
-use crate::syntax::Symbol;
+use crate::syntax::is_keyword;
 use btc_lang::rules::ast::Item;
 use btc_lang::rules::lexer::Tok;
+use btc_lang::rules::resolve::Target;
 use btc_pddl::source::Span;
+use std::collections::HashMap;
 use tower_lsp::lsp_types::{
     InlayHint, InlayHintKind, InlayHintLabel, Range, SemanticToken, SemanticTokenType,
     SemanticTokensLegend,
@@ -36,33 +38,51 @@ fn type_index(t: SemanticTokenType) -> u32 {
     TOKEN_TYPES.iter().position(|x| *x == t).unwrap_or(0) as u32
 }
 
-/// Classified spans of a file, in order.
+/// The token type of a resolved name.
+fn of_target(t: &Target) -> SemanticTokenType {
+    match t {
+        Target::Callable { .. } => SemanticTokenType::FUNCTION,
+        Target::Table { .. } => SemanticTokenType::ENUM,
+        Target::Port { .. } => SemanticTokenType::PROPERTY,
+        Target::Var { .. } | Target::Capture { .. } => SemanticTokenType::PARAMETER,
+        Target::Action { .. } => SemanticTokenType::METHOD,
+        Target::Predicate { .. } => SemanticTokenType::MACRO,
+        Target::Type { .. } | Target::BasicType { .. } | Target::Std { .. } => {
+            SemanticTokenType::TYPE
+        }
+        Target::Object { .. } | Target::File { .. } => SemanticTokenType::STRING,
+    }
+}
+
+/// Classified spans of a file, in order: names as the checker resolved
+/// them, keywords, literals and comments from the tokens (so a file that
+/// does not parse still shows its keywords and strings).
 pub fn classified(a: &Analysis) -> Vec<(Span, SemanticTokenType)> {
+    let mut names: HashMap<u32, SemanticTokenType> = HashMap::new();
+    for k in 0..a.items.len() {
+        for (span, r) in a.names_of(k) {
+            names
+                .entry(span.start)
+                .or_insert_with(|| of_target(&r.target));
+        }
+    }
     let mut out = Vec::new();
-    for (i, (tok, span)) in a.syntax.tokens.toks.iter().enumerate() {
+    for (tok, span) in a.syntax.tokens.toks {
         let ty = match tok {
             Tok::Str(_) => Some(SemanticTokenType::STRING),
             Tok::Int(_) | Tok::Float(_) => Some(SemanticTokenType::NUMBER),
             Tok::Var(_) => Some(SemanticTokenType::PARAMETER),
-            Tok::Ident(_) => match a.syntax.classify(i) {
-                Some(Symbol::Keyword) => Some(SemanticTokenType::KEYWORD),
-                Some(Symbol::Node { .. }) => Some(SemanticTokenType::FUNCTION),
-                Some(Symbol::Table { .. }) => Some(SemanticTokenType::ENUM),
-                Some(Symbol::Port { .. }) => Some(SemanticTokenType::PROPERTY),
-                Some(Symbol::Type { .. }) => Some(SemanticTokenType::TYPE),
-                Some(Symbol::Predicate { .. }) => Some(SemanticTokenType::MACRO),
-                Some(Symbol::RuleHead { .. }) => Some(SemanticTokenType::METHOD),
-                Some(Symbol::Capture { .. }) => Some(SemanticTokenType::PARAMETER),
-                Some(Symbol::Std { .. }) => Some(SemanticTokenType::TYPE),
-                _ => None,
-            },
+            Tok::Ident(word) => names
+                .get(&span.start)
+                .cloned()
+                .or_else(|| is_keyword(word).then_some(SemanticTokenType::KEYWORD)),
             _ => None,
         };
         if let Some(t) = ty {
             out.push((*span, t));
         }
     }
-    for c in &a.syntax.tokens.comments {
+    for c in a.syntax.tokens.comments {
         out.push((c.span, SemanticTokenType::COMMENT));
     }
     out.sort_by_key(|(s, _)| s.start);

@@ -1,71 +1,69 @@
-//! Hover, go-to-definition, find references and rename.
+//! Hover, go-to-definition, find references, highlights and rename: all
+//! over the checker's resolutions (`btc_lang::resolutions`); nothing here
+//! works out what a name means.
 
 use crate::analysis::{shift, Analysis, Place};
-use crate::syntax::Symbol;
-use btc_lang::db::file_id;
+use btc_lang::db::rules_items;
+use btc_lang::resolutions::{item_resolutions, Resolved, Site};
 use btc_lang::rules::ast::{Item, NodeKind};
 use btc_lang::rules::name::Key;
+use btc_lang::rules::resolve::Target;
 use btc_pddl::source::Span;
 use std::collections::HashMap;
 use tower_lsp::lsp_types::{
-    Hover, HoverContents, Location, MarkupContent, MarkupKind, TextEdit, Url, WorkspaceEdit,
+    DocumentHighlight, DocumentHighlightKind, Hover, HoverContents, Location, MarkupContent,
+    MarkupKind, TextEdit, Url, WorkspaceEdit,
 };
 
 fn code_block(lang: &str, text: &str) -> String {
     format!("```{lang}\n{}\n```", text.trim_end())
 }
 
+fn quoted(names: &[String]) -> String {
+    names
+        .iter()
+        .map(|t| format!("`{t}`"))
+        .collect::<Vec<_>>()
+        .join(" or ")
+}
+
 /// The hover text at a byte offset.
 pub fn hover(a: &Analysis, offset: usize) -> Option<Hover> {
-    let (sym, span) = a.syntax.symbol_at(offset)?;
-    let text = match &sym {
-        Symbol::RuleHead { item } => {
-            let r = a.rule(*item)?;
-            let actions = a.actions_of(r);
-            if actions.is_empty() {
-                format!(
-                    "`{}`: no action of the domain matches",
-                    r.pattern.name_text()
-                )
-            } else {
-                let (dfile, _, _) = a.domain?;
-                actions
-                    .iter()
-                    .map(|act| code_block("pddl", a.source_of(dfile, act.span)))
-                    .collect::<Vec<_>>()
-                    .join("\n\n")
-            }
+    let names = a.names_at(offset);
+    let (span, first) = *names.first()?;
+    let item = a.syntax.item_at(span.start)?;
+    let text = match &first.target {
+        Target::Action { .. } => {
+            let (dfile, _, _) = a.domain?;
+            names
+                .iter()
+                .filter_map(|(_, r)| r.site)
+                .map(|s| {
+                    let p = a.place(s);
+                    let action = a.domain?.1.actions.iter().find(|x| x.name.span == p.span)?;
+                    Some(code_block("pddl", a.source_of(dfile, action.span)))
+                })
+                .collect::<Option<Vec<_>>>()?
+                .join("\n\n")
         }
-        Symbol::Var { item, name } => match &a.items[*item].item {
+        Target::Var { name, .. } => match &a.items[item].item {
             Item::Rule(r) => {
-                let types = a.var_types(*item, name);
-                let pos = r.pattern.params.iter().position(|p| p.var.text == *name);
-                match (pos, types.is_empty()) {
-                    (Some(p), false) => format!(
+                let types = a.var_types(item, name);
+                match r.pattern.params.iter().position(|p| p.var.text == *name) {
+                    Some(p) if !types.is_empty() => format!(
                         "`?{name}`: {} (parameter {} of `{}`)",
-                        types
-                            .iter()
-                            .map(|t| format!("`{t}`"))
-                            .collect::<Vec<_>>()
-                            .join(" or "),
+                        quoted(&types),
                         p + 1,
                         r.pattern.name_text()
                     ),
-                    (Some(p), true) => format!("`?{name}`: parameter {} of the rule", p + 1),
-                    (None, _) => format!("`?{name}` is not a parameter of this rule"),
+                    Some(p) => format!("`?{name}`: parameter {} of the rule", p + 1),
+                    None => format!("`?{name}`: bound by its quantifier"),
                 }
             }
-            Item::Tree(t) => match t.ports.iter().find(|p| p.name.text == *name) {
-                Some(p) => format!(
-                    "`?{name}`: `{}` (a port of tree `{}`)",
-                    p.ty.text, t.name.text
-                ),
-                None => format!("`?{name}` is not a port of tree `{}`", t.name.text),
-            },
-            _ => format!("`?{name}`"),
+            _ => format!("`?{name}`: bound by its quantifier"),
         },
-        Symbol::Capture { item, name } => {
-            let r = a.rule(*item)?;
+        Target::Capture { name, .. } => {
+            let r = a.rule(item)?;
             let values: Vec<String> = a
                 .actions_of(r)
                 .iter()
@@ -81,36 +79,33 @@ pub fn hover(a: &Analysis, offset: usize) -> Option<Hover> {
                 format!("capture `{name}`: {}", values.join(", "))
             }
         }
-        Symbol::Node { name, .. } => {
-            let (place, item) = a.declaration(name, false)?;
-            let decl = match item {
-                Item::Node(n) => {
-                    let kind = match n.kind {
-                        NodeKind::Action => "action",
-                        NodeKind::Condition => "condition",
-                    };
-                    let mut s = format!(
-                        "{kind} {}({})",
-                        n.name.text,
-                        btc_lang::rules::fmt::ports(&n.ports)
+        Target::Callable { name } => {
+            let place = a.place(first.site?);
+            let decl = if let Some(n) = a.decls.nodes.get(name) {
+                let kind = match n.kind {
+                    NodeKind::Action => "action",
+                    NodeKind::Condition => "condition",
+                };
+                let mut s = format!(
+                    "{kind} {}({})",
+                    n.name.text,
+                    btc_lang::rules::fmt::ports(&n.ports)
+                );
+                if let Some(f) = &n.formula {
+                    let src = a.source_of(
+                        place.file,
+                        shift(f.span(), place.span.start - n.name.span.start),
                     );
-                    if let Some(f) = &n.formula {
-                        let src = a.source_of(
-                            place.file,
-                            shift(f.span(), place.span.start - n.name.span.start),
-                        );
-                        s.push_str(&format!(" = {src}"));
-                    }
-                    s
+                    s.push_str(&format!(" = {src}"));
                 }
-                Item::Tree(t) => {
-                    format!(
-                        "tree {}({})",
-                        t.name.text,
-                        btc_lang::rules::fmt::ports(&t.ports)
-                    )
-                }
-                _ => return None,
+                s
+            } else {
+                let t = a.decls.trees.get(name)?;
+                format!(
+                    "tree {}({})",
+                    t.name.text,
+                    btc_lang::rules::fmt::ports(&t.ports)
+                )
             };
             let origin = place.file.path(&a.ws.db);
             format!(
@@ -121,16 +116,14 @@ pub fn hover(a: &Analysis, offset: usize) -> Option<Hover> {
                     .map_or_else(|| origin.to_string(), str::to_owned)
             )
         }
-        Symbol::Table { name, .. } => {
-            let (place, _) = a.declaration(name, true)?;
-            let Item::Table(t) = a.declaration(name, true)?.1 else {
-                return None;
-            };
+        Target::Table { name } => {
+            let place = a.place(first.site?);
+            let t = a.decls.tables.get(name)?;
+            let off = place.span.start - t.name.span.start;
             let entries: Vec<String> = t
                 .entries
                 .iter()
                 .map(|e| {
-                    let off = place.span.start - t.name.span.start;
                     format!(
                         "{}: {}",
                         e.key.text,
@@ -143,55 +136,62 @@ pub fn hover(a: &Analysis, offset: usize) -> Option<Hover> {
                 &format!("table {} {{ {} }}", t.name.text, entries.join(", ")),
             )
         }
-        Symbol::Port { node, port, .. } => {
-            let ports = a.decls.ports(node)?;
-            let p = ports.iter().find(|p| p.name.text == *port)?;
+        Target::Port { owner, name } => {
+            let p = a
+                .decls
+                .ports(owner)?
+                .iter()
+                .find(|p| p.name.text == *name)?;
             format!(
-                "port `{}` of `{node}`: `{}`{}",
+                "port `{}` of `{owner}`: `{}`{}",
                 p.name.text,
                 p.ty.text,
                 if p.out { " (output)" } else { "" }
             )
         }
-        Symbol::Predicate { name } => {
+        Target::Predicate { .. } => {
             let (dfile, d, _) = a.domain?;
-            let p = d.predicates.iter().find(|p| p.name.name == *name)?;
-            code_block("pddl", a.source_of(dfile, p.span))
+            let at = a.place(first.site?).span;
+            let decl = d
+                .predicates
+                .iter()
+                .map(|p| (&p.name, p.span))
+                .chain(d.functions.iter().map(|f| (&f.name, f.span)))
+                .find(|(n, _)| n.span == at)?;
+            code_block("pddl", a.source_of(dfile, decl.1))
         }
-        Symbol::Type { name } => {
+        Target::Type { name } => {
             let (_, _, dix) = a.domain?;
-            let key = Key::new(name);
-            let lower = key.as_str();
-            match dix.types.id(lower) {
-                Some(id) => {
-                    let parents: Vec<&str> = dix
-                        .types
-                        .names()
-                        .filter(|t| *t != lower)
-                        .filter(|t| dix.types.id(t).is_some_and(|p| dix.types.is_subtype(id, p)))
-                        .collect();
-                    if parents.is_empty() {
-                        format!("PDDL type `{lower}`")
-                    } else {
-                        format!(
-                            "PDDL type `{lower}`, a kind of {}",
-                            parents
-                                .iter()
-                                .map(|p| format!("`{p}`"))
-                                .collect::<Vec<_>>()
-                                .join(", ")
-                        )
-                    }
-                }
-                None => format!("`{name}`: a basic type"),
+            let id = dix.types.id(name)?;
+            let parents: Vec<String> = dix
+                .types
+                .names()
+                .filter(|t| *t != name)
+                .filter(|t| dix.types.id(t).is_some_and(|p| dix.types.is_subtype(id, p)))
+                .map(|t| format!("`{t}`"))
+                .collect();
+            if parents.is_empty() {
+                format!("PDDL type `{name}`")
+            } else {
+                format!("PDDL type `{name}`, a kind of {}", parents.join(", "))
             }
         }
-        Symbol::Path { written } => match a.ws.resolve_written(a.file, written) {
-            Some(p) => format!("`{p}`"),
+        Target::BasicType { name } => format!("`{name}`: a basic type"),
+        Target::Object { name } => {
+            let place = a.place(first.site?);
+            let origin = place.file.path(&a.ws.db);
+            format!(
+                "PDDL object `{name}`, declared in `{}`",
+                origin
+                    .file_name()
+                    .map_or_else(|| origin.to_string(), str::to_owned)
+            )
+        }
+        Target::File { written } => match first.site {
+            Some(s) => format!("`{}`", s.file(&a.ws.db).path(&a.ws.db)),
             None => format!("`{written}` is not found"),
         },
-        Symbol::Std { module } => format!("stdlib module `std::{module}`"),
-        Symbol::Keyword => return None,
+        Target::Std { module } => format!("stdlib module `std::{module}`"),
     };
     Some(Hover {
         contents: HoverContents::Markup(MarkupContent {
@@ -202,196 +202,126 @@ pub fn hover(a: &Analysis, offset: usize) -> Option<Hover> {
     })
 }
 
-/// Where the symbol at `offset` is defined.
-pub fn definition(a: &Analysis, offset: usize) -> Option<Place> {
-    let (sym, _) = a.syntax.symbol_at(offset)?;
-    match sym {
-        Symbol::RuleHead { item } => {
-            let r = a.rule(item)?;
-            let (dfile, _, _) = a.domain?;
-            let act = *a.actions_of(r).first()?;
-            Some(Place {
-                file: dfile,
-                span: act.name.span,
-            })
+/// Where the name at `offset` is declared: one place, or several for a
+/// pattern that matches several actions.
+pub fn definition(a: &Analysis, offset: usize) -> Vec<Place> {
+    let mut out: Vec<Place> = Vec::new();
+    for (_, r) in a.names_at(offset) {
+        if let Some(s) = r.site {
+            let p = a.place(s);
+            if !out.contains(&p) {
+                out.push(p);
+            }
         }
-        Symbol::Var { item, name } => {
-            let n = &a.items[item];
-            let span = match &n.item {
-                Item::Rule(r) => {
-                    r.pattern
-                        .params
-                        .iter()
-                        .find(|p| p.var.text == name)?
-                        .var
-                        .span
-                }
-                Item::Tree(t) => t.ports.iter().find(|p| p.name.text == name)?.name.span,
-                _ => return None,
-            };
-            Some(Place {
-                file: a.file,
-                span: shift(span, n.offset),
-            })
-        }
-        Symbol::Capture { item, name } => {
-            let n = &a.items[item];
-            let r = a.rule(item)?;
-            let span = r.pattern.name.iter().find_map(|p| match p {
-                btc_lang::rules::ast::NamePart::Capture { name: c } if c.text == name => {
-                    Some(c.span)
-                }
-                _ => None,
-            })?;
-            Some(Place {
-                file: a.file,
-                span: shift(span, n.offset),
-            })
-        }
-        Symbol::Node { name, .. } => a.declaration(&name, false).map(|(p, _)| p),
-        Symbol::Table { name, .. } => a.declaration(&name, true).map(|(p, _)| p),
-        Symbol::Port { node, port, .. } => {
-            let (place, item) = a.declaration(&node, false)?;
-            let (ports, name_span) = match item {
-                Item::Node(n) => (&n.ports, n.name.span),
-                Item::Tree(t) => (&t.ports, t.name.span),
-                _ => return None,
-            };
-            let p = ports.iter().find(|p| p.name.text == port)?;
-            Some(Place {
-                file: place.file,
-                span: shift(p.name.span, place.span.start - name_span.start),
-            })
-        }
-        Symbol::Predicate { name } => {
-            let (dfile, d, _) = a.domain?;
-            let p = d.predicates.iter().find(|p| p.name.name == name)?;
-            Some(Place {
-                file: dfile,
-                span: p.name.span,
-            })
-        }
-        Symbol::Type { name } => {
-            let (dfile, d, _) = a.domain?;
-            let key = Key::new(&name);
-            let t = d.types.iter().find(|t| t.name.name == key.as_str())?;
-            Some(Place {
-                file: dfile,
-                span: t.name.span,
-            })
-        }
-        Symbol::Path { written } => {
-            let path = a.ws.resolve_written(a.file, &written)?;
-            let f = a.ws.file(&path)?;
-            Some(Place {
-                file: f,
-                span: Span::new(file_id(&a.ws.db, f), 0, 0),
-            })
-        }
-        Symbol::Std { .. } | Symbol::Keyword => None,
     }
+    out
 }
 
-/// Every place that names the same thing as the symbol at `offset`
-/// (declaration included), across the rules files in scope.
+/// The name at `offset`, the one whose declaration the others share.
+fn site_at<'a>(a: &Analysis<'a>, offset: usize) -> Option<(&'a Resolved<'a>, Site<'a>)> {
+    a.names_at(offset)
+        .into_iter()
+        .find_map(|(_, r)| r.site.map(|s| (r, s)))
+}
+
+/// Every place that names the same declaration as the name at `offset`
+/// (the declaration included, when it is in a rules file the server
+/// knows), in every rules file the server knows; variables and captures
+/// only within their item.
 pub fn references(a: &Analysis, offset: usize) -> Option<Vec<Place>> {
-    let (sym, _) = a.syntax.symbol_at(offset)?;
+    let (r, site) = site_at(a, offset)?;
+    let db = &a.ws.db;
     let mut out = Vec::new();
-    match &sym {
-        Symbol::Var { item, name } | Symbol::Capture { item, name } => {
-            let var = matches!(sym, Symbol::Var { .. });
-            let n = &a.items[*item];
-            let end = a
-                .items
-                .get(item + 1)
-                .map_or(a.text.len() as u32, |m| m.offset);
-            for (i, (_, s)) in a.syntax.tokens.toks.iter().enumerate() {
-                if s.start < n.offset || s.end > end {
-                    continue;
-                }
-                let same = match a.syntax.classify(i) {
-                    Some(Symbol::Var { name: m, .. }) if var => m == *name,
-                    Some(Symbol::Capture { name: m, .. }) => !var && m == *name,
-                    _ => false,
-                };
-                // A bare capture use (`marker[op]`) is a name token too.
-                let bare = !var
-                    && matches!(&a.syntax.tokens.toks[i].0, btc_lang::rules::lexer::Tok::Ident(t) if t == name)
-                    && !a.syntax.tokens.in_pddl(i);
-                if same || bare {
-                    out.push(Place {
-                        file: a.file,
-                        span: *s,
-                    });
-                }
-            }
-            for s in a.syntax.interpolations(*item, name, var) {
+    let mut scan = |file, item| {
+        let o = btc_lang::db::RulesItem::offset(item, db);
+        for other in item_resolutions(db, item) {
+            if other.site == Some(site) {
                 out.push(Place {
-                    file: a.file,
-                    span: s,
+                    file,
+                    span: shift(other.span, o),
                 });
             }
         }
-        Symbol::Node { name, .. }
-        | Symbol::Table { name, .. }
-        | Symbol::Port { port: name, .. } => {
+    };
+    match (&r.target, site) {
+        (Target::Var { .. } | Target::Capture { .. }, Site::Item { item, .. }) => {
+            scan(item.file(db), item)
+        }
+        _ => {
             for f in a.ws.all_rules() {
-                let Some(other) = Analysis::new(a.ws, f.path(&a.ws.db)) else {
-                    continue;
-                };
-                // Only files that see the same declaration.
-                if !other.closure().iter().any(|g| a.closure().contains(g)) {
-                    continue;
-                }
-                for (i, (_, s)) in other.syntax.tokens.toks.iter().enumerate() {
-                    let same = match (&sym, other.syntax.classify(i)) {
-                        (Symbol::Node { .. }, Some(Symbol::Node { name: m, .. })) => m == *name,
-                        (Symbol::Table { .. }, Some(Symbol::Table { name: m, .. })) => m == *name,
-                        (
-                            Symbol::Port { node, .. },
-                            Some(Symbol::Port {
-                                node: n2, port: p2, ..
-                            }),
-                        ) => n2 == *node && p2 == *name,
-                        _ => false,
-                    };
-                    if same {
-                        out.push(Place { file: f, span: *s });
-                    }
+                for &item in rules_items(db, f) {
+                    scan(f, item);
                 }
             }
         }
-        Symbol::Predicate { .. } | Symbol::RuleHead { .. } | Symbol::Type { .. } => {
-            // References of PDDL names within the rules in scope.
-            for (i, (_, s)) in a.syntax.tokens.toks.iter().enumerate() {
-                if a.syntax.classify(i).as_ref() == Some(&sym) {
-                    out.push(Place {
-                        file: a.file,
-                        span: *s,
-                    });
-                }
-            }
-            if let Some(def) = definition(a, offset) {
-                out.insert(0, def);
-            }
-        }
-        Symbol::Path { .. } | Symbol::Std { .. } | Symbol::Keyword => return None,
     }
-    out.sort_by_key(|p| (p.file.path(&a.ws.db).clone(), p.span.start));
+    // A declaration outside the rules files (the domain) counts too.
+    let decl = a.place(site);
+    if !out.contains(&decl) && matches!(site, Site::File { .. }) && decl.span.end > 0 {
+        out.push(decl);
+    }
+    out.sort_by_key(|p| (p.file.path(db).clone(), p.span.start));
     out.dedup();
     Some(out)
+}
+
+/// The places in this file that name what the name at `offset` names;
+/// the declaration is a write, the others reads.
+pub fn highlights(a: &Analysis, offset: usize) -> Option<Vec<DocumentHighlight>> {
+    let (_, site) = site_at(a, offset)?;
+    let decl = a.place(site);
+    Some(
+        references(a, offset)?
+            .into_iter()
+            .filter(|p| p.file == a.file)
+            .map(|p| DocumentHighlight {
+                range: a.range(p.span),
+                kind: Some(if p == decl {
+                    DocumentHighlightKind::WRITE
+                } else {
+                    DocumentHighlightKind::READ
+                }),
+            })
+            .collect(),
+    )
 }
 
 /// Why a rename cannot be done.
 #[derive(Debug, PartialEq)]
 pub struct RenameError(pub String);
 
-/// The edits that rename the symbol at `offset` (variables, captures,
-/// nodes, trees, tables, ports) to `new_name`.
-pub fn rename(a: &Analysis, offset: usize, new_name: &str) -> Result<WorkspaceEdit, RenameError> {
-    let Some((sym, _)) = a.syntax.symbol_at(offset) else {
+/// The name at `offset` if it can be renamed: its span, or why not.
+pub fn prepare_rename(a: &Analysis, offset: usize) -> Result<Span, RenameError> {
+    let names = a.names_at(offset);
+    let Some((span, r)) = names.first() else {
         return Err(RenameError("nothing to rename here".into()));
     };
+    if !r.target.renamable() {
+        return Err(RenameError(match r.target {
+            Target::Action { .. }
+            | Target::Predicate { .. }
+            | Target::Type { .. }
+            | Target::Object { .. } => {
+                "PDDL names cannot be renamed here: they live in the domain or the problem".into()
+            }
+            _ => "only variables, captures, nodes, trees, tables and ports can be renamed".into(),
+        }));
+    }
+    let Some(site) = r.site else {
+        return Err(RenameError("nothing to rename here".into()));
+    };
+    if a.location(&a.place(site)).is_none() {
+        return Err(RenameError(
+            "the name is declared in the stdlib, which cannot be edited".into(),
+        ));
+    }
+    Ok(*span)
+}
+
+/// The edits that rename the name at `offset` (variables, captures,
+/// nodes, trees, tables, ports) to `new_name`, in every file that uses it.
+pub fn rename(a: &Analysis, offset: usize, new_name: &str) -> Result<WorkspaceEdit, RenameError> {
+    prepare_rename(a, offset)?;
     let bare = new_name.trim_start_matches('?');
     let valid = bare.starts_with(|c: char| c.is_alphabetic() || c == '_')
         && bare
@@ -400,31 +330,35 @@ pub fn rename(a: &Analysis, offset: usize, new_name: &str) -> Result<WorkspaceEd
     if !valid {
         return Err(RenameError(format!("`{new_name}` is not a valid name")));
     }
-    let replacement = match sym {
-        Symbol::Var { .. } => format!("?{}", Key::new(bare)),
-        Symbol::Capture { .. } | Symbol::Node { .. } | Symbol::Table { .. } | Symbol::Port { .. } => {
-            bare.to_owned()
-        }
-        _ => {
-            return Err(RenameError(
-                "only variables, captures, nodes, trees, tables and ports can be renamed here (PDDL names live in the domain)".into(),
-            ))
-        }
+    let is_var = matches!(
+        a.names_at(offset).first().map(|(_, r)| &r.target),
+        Some(Target::Var { .. })
+    );
+    // Variables are folded, like every PDDL name.
+    let bare = if is_var {
+        Key::new(bare).into_string()
+    } else {
+        bare.to_owned()
     };
     let places = references(a, offset).unwrap_or_default();
     let mut changes: HashMap<Url, Vec<TextEdit>> = HashMap::new();
     for p in places {
-        // Interpolations (`{?x}`) cover the name without braces.
-        let Some(loc) = a.location(&p) else {
+        let Some(Location { uri, range }) = a.location(&p) else {
             return Err(RenameError(
-                "the name is declared in the stdlib, which cannot be edited".into(),
+                "the name is used in the stdlib, which cannot be edited".into(),
             ));
         };
-        let Location { uri, range } = loc;
+        // A tree's port is `name` where declared and `?name` in its body.
+        let written = a.source_of(p.file, p.span);
+        let replacement = if written.starts_with('?') {
+            format!("?{bare}")
+        } else {
+            bare.clone()
+        };
         changes
             .entry(uri)
             .or_default()
-            .push(TextEdit::new(range, replacement.clone()));
+            .push(TextEdit::new(range, replacement));
     }
     Ok(WorkspaceEdit::new(changes))
 }

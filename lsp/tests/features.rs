@@ -1,5 +1,10 @@
-//! Every editor feature, driven in process through the real LSP service with
-//! the examples as fixtures.
+//! Diagnostics, quick fixes, completion contexts, signature help,
+//! formatting and file watching, driven in process through the real LSP
+//! service on the examples. Hover, definition, references, rename,
+//! highlights, semantic tokens, inlay hints, symbols and code actions are
+//! `tests/cursor.rs` (fixtures with a cursor, results drawn on the
+//! source); `tests/service.rs` has their wire shapes and a smoke test over
+//! every example.
 
 mod common;
 
@@ -109,98 +114,6 @@ async fn positions_count_utf16_units_after_non_ascii_text() {
     // An edit inside the line with the clef, in UTF-16 columns: `?too` -> `?to`.
     c.change(&u, 2, [line, 75, line, 76], "").await;
     assert!(c.diagnostics_for(&u).await.is_empty());
-}
-
-#[tokio::test]
-async fn hover_shows_actions_variables_nodes_ports_and_predicates() {
-    let mut c = TestClient::new().await;
-    let path = ariac();
-    let text = text_of(&path);
-    let u = c.open(&path).await;
-    let (l, col) = pos(&text, "rule (grasp", 7);
-    let h = hover_text(&c.at("textDocument/hover", &u, l, col).await);
-    assert!(
-        h.contains("(:action grasp") && h.contains(":effect (attach ?part ?robot)"),
-        "{h}"
-    );
-
-    let (l, col) = pos(&text, "part: ?part, source", 8);
-    let h = hover_text(&c.at("textDocument/hover", &u, l, col).await);
-    assert!(
-        h.contains("`?part`: `part` (parameter 2 of `grasp`)"),
-        "{h}"
-    );
-
-    let (l, col) = pos(&text, "Grasp(robot: ?robot, part", 1);
-    let h = hover_text(&c.at("textDocument/hover", &u, l, col).await);
-    assert!(
-        h.contains("action Grasp(robot: robot, part: part, source: container)"),
-        "{h}"
-    );
-
-    let (l, col) = pos(&text, "source: ?bin", 1);
-    let h = hover_text(&c.at("textDocument/hover", &u, l, col).await);
-    assert_eq!(h, "port `source` of `Grasp`: `container`");
-
-    let (l, col) = pos(&text, "(on ?part ?agv)", 1);
-    let h = hover_text(&c.at("textDocument/hover", &u, l, col).await);
-    assert!(
-        h.contains("(on ?part - part ?container - container)"),
-        "{h}"
-    );
-
-    let (l, col) = pos(&text, "target: container)", 9);
-    let h = hover_text(&c.at("textDocument/hover", &u, l, col).await);
-    assert!(h.contains("PDDL type `container`"), "{h}");
-
-    let (l, col) = pos(&text, "RobotNormal(robot: robot)", 1);
-    let h = hover_text(&c.at("textDocument/hover", &u, l, col).await);
-    assert!(h.contains("= (is_enabled ?robot)"), "{h}");
-}
-
-#[tokio::test]
-async fn definitions_lead_into_the_domain_and_to_declarations() {
-    let mut c = TestClient::new().await;
-    let path = ariac();
-    let text = text_of(&path);
-    let domain = repo().join("examples/ariac/domain.pddl");
-    let dtext = text_of(&domain);
-    let u = c.open(&path).await;
-
-    let (l, col) = pos(&text, "rule (place", 7);
-    let d = c.at("textDocument/definition", &u, l, col).await;
-    assert_eq!(d["uri"], json!(uri(&domain)));
-    let (dl, dc) = pos(&dtext, "(:action place", 9);
-    assert_eq!(d["range"]["start"], json!({ "line": dl, "character": dc }));
-
-    let (l, col) = pos(&text, "Place(robot: ?robot, part", 2);
-    let d = c.at("textDocument/definition", &u, l, col).await;
-    let (dl, dc) = pos(&text, "action Place(", 7);
-    assert_eq!(d["uri"], json!(u));
-    assert_eq!(d["range"]["start"], json!({ "line": dl, "character": dc }));
-
-    let (l, col) = pos(&text, "(attach ?part ?robot)))", 2);
-    let d = c.at("textDocument/definition", &u, l, col).await;
-    let (dl, dc) = pos(&dtext, "(attach ?part - part", 1);
-    assert_eq!(d["range"]["start"], json!({ "line": dl, "character": dc }));
-
-    let (l, col) = pos(&text, "domain \"domain.pddl\"", 10);
-    let d = c.at("textDocument/definition", &u, l, col).await;
-    assert_eq!(d["uri"], json!(uri(&domain)));
-
-    let (l, col) = pos(&text, "target: ?to)", 9);
-    let d = c.at("textDocument/definition", &u, l, col).await;
-    let (dl, dc) = pos(&text, "?to) {", 0);
-    assert_eq!(d["range"]["start"], json!({ "line": dl, "character": dc }));
-
-    // A table and its lookup in the P3 example.
-    let p3 = repo().join("examples/p3_assembler/rules.btrules");
-    let p3text = text_of(&p3);
-    let u3 = c.open(&p3).await;
-    let (l, col) = pos(&p3text, "marker_pick[op]", 2);
-    let d = c.at("textDocument/definition", &u3, l, col).await;
-    let (dl, dc) = pos(&p3text, "table marker_pick", 6);
-    assert_eq!(d["range"]["start"], json!({ "line": dl, "character": dc }));
 }
 
 #[tokio::test]
@@ -401,48 +314,6 @@ async fn semantic_tokens_inlay_hints_and_formatting() {
         apply(&messy, &edits),
         btc_lang::rules::fmt::format(&messy).unwrap()
     );
-}
-
-#[tokio::test]
-async fn rename_changes_every_use_including_interpolations() {
-    let mut c = TestClient::new().await;
-    let path = ariac();
-    let text = text_of(&path);
-    let u = c.open(&path).await;
-    let (l, col) = pos(&text, "?to) {", 1);
-    let edit = c
-        .request(
-            "textDocument/rename",
-            json!({ "textDocument": { "uri": u }, "position": { "line": l, "character": col }, "newName": "dest" }),
-        )
-        .await;
-    let renamed = apply(&text, &edit["changes"][u.as_str()]);
-    assert!(renamed.contains("rule (move ?robot ?from ?dest) {"));
-    assert!(renamed.contains("\"move {?robot} to {?dest}\""));
-    assert!(renamed.contains("target: ?dest)"));
-    assert!(
-        renamed.contains("rule (place ?robot ?part ?agv)"),
-        "other rules untouched"
-    );
-
-    let (l, col) = pos(&text, "action MoveTo", 8);
-    let edit = c
-        .request(
-            "textDocument/rename",
-            json!({ "textDocument": { "uri": u }, "position": { "line": l, "character": col }, "newName": "Navigate" }),
-        )
-        .await;
-    let renamed = apply(&text, &edit["changes"][u.as_str()]);
-    assert_eq!(renamed.matches("Navigate(").count(), 2);
-    assert!(!renamed.contains("MoveTo"));
-
-    let bad = c
-        .try_request(
-            "textDocument/rename",
-            json!({ "textDocument": { "uri": u }, "position": { "line": l, "character": col }, "newName": "no way" }),
-        )
-        .await;
-    assert!(bad.unwrap_err().contains("not a valid name"));
 }
 
 #[tokio::test]

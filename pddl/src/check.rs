@@ -226,6 +226,26 @@ struct Checker<'a> {
     durative: bool,
 }
 
+impl<'a> Checker<'a> {
+    /// A checker for a formula or effect written outside the domain (in a
+    /// rules file): the requirements it uses go unreported, nothing is
+    /// durative.
+    fn outside(
+        domain: &'a Domain,
+        index: &'a DomainIndex,
+        problem: Option<&'a ProblemIndex>,
+    ) -> Checker<'a> {
+        Checker {
+            domain,
+            index,
+            problem,
+            diags: Vec::new(),
+            used: FxHashMap::default(),
+            durative: false,
+        }
+    }
+}
+
 pub type Scope = Vec<(String, Vec<TypeId>)>;
 
 /// Checks a domain and builds its index.
@@ -469,14 +489,7 @@ pub fn check_formula_in(
     f: &Formula,
     scope: &[(String, Vec<TypeId>)],
 ) -> Vec<Diagnostic> {
-    let mut c = Checker {
-        domain,
-        index,
-        problem,
-        diags: Vec::new(),
-        used: FxHashMap::default(),
-        durative: false,
-    };
+    let mut c = Checker::outside(domain, index, problem);
     c.formula(f, &scope.to_vec());
     c.diags
 }
@@ -489,14 +502,7 @@ pub fn check_effect_in(
     e: &Effect,
     scope: &[(String, Vec<TypeId>)],
 ) -> Vec<Diagnostic> {
-    let mut c = Checker {
-        domain,
-        index,
-        problem,
-        diags: Vec::new(),
-        used: FxHashMap::default(),
-        durative: false,
-    };
+    let mut c = Checker::outside(domain, index, problem);
     c.effect(e, &scope.to_vec());
     c.diags
 }

@@ -92,15 +92,18 @@ fn planning_from_a_knowledge_base_state() {
     kb.facts.remove(&key("on", &["battery_red", "bin1"]));
     kb.facts
         .insert(key("attach", &["battery_red", "floor_robot"]));
-    let report = btc_planner::plan_from(
-        domain,
-        &l.du.index,
-        &l.pu.index,
-        &kb,
-        problem.goal.as_ref(),
-        &Options::default(),
-    )
-    .unwrap();
+    let plan_from = |kb: &btc_pddl::state::State| {
+        btc_planner::plan_from(
+            domain,
+            &l.du.index,
+            &l.pu.index,
+            kb,
+            problem.goal.as_ref(),
+            &Options::default(),
+        )
+        .unwrap()
+    };
+    let report = plan_from(&kb);
     let Outcome::Plan(plan) = report.outcome else {
         panic!("no plan")
     };
@@ -111,16 +114,7 @@ fn planning_from_a_knowledge_base_state() {
     );
     // With the robot disabled nothing can happen.
     kb.facts.remove(&key("is_enabled", &["floor_robot"]));
-    let report = btc_planner::plan_from(
-        domain,
-        &l.du.index,
-        &l.pu.index,
-        &kb,
-        problem.goal.as_ref(),
-        &Options::default(),
-    )
-    .unwrap();
-    assert_eq!(report.outcome, Outcome::Unsolvable);
+    assert_eq!(plan_from(&kb).outcome, Outcome::Unsolvable);
 }
 
 #[test]

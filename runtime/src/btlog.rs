@@ -18,7 +18,7 @@
 
 use crate::engine::{Engine, Status, TraceItem};
 use crate::error::LoadError;
-use crate::spec::{default_name, Kind, SNode, TreeDoc};
+use crate::spec::{default_name, Kind, SNode, TreeDoc, Verdict};
 use btc_ir::{LeafKind, PortDirection, PortValue};
 use btc_pddl::diagnostic::codes;
 use quick_xml::escape::escape;
@@ -249,6 +249,16 @@ fn doc_model(m: &btc_ir::NodeModel) -> Model {
     Model { element: e }
 }
 
+/// A status as BT.CPP writes it (`Precondition`'s `else`).
+fn verdict_text(v: Verdict) -> &'static str {
+    match v {
+        Verdict::Success => "SUCCESS",
+        Verdict::Failure => "FAILURE",
+        Verdict::Skipped => "SKIPPED",
+        Verdict::Running => "RUNNING",
+    }
+}
+
 fn port_text(v: &PortValue) -> String {
     match v {
         PortValue::Param(p) => format!("{{{p}}}"),
@@ -280,6 +290,21 @@ impl Writer<'_, '_> {
             Kind::Retry(k) => vec![("num_attempts".into(), k.to_string())],
             Kind::Repeat(k) => vec![("num_cycles".into(), k.to_string())],
             Kind::Timeout(ms) => vec![("msec".into(), ms.to_string())],
+            Kind::Switch { variable, cases } => std::iter::once(("variable".into(), variable))
+                .chain(
+                    cases
+                        .iter()
+                        .enumerate()
+                        .map(|(k, c)| (format!("case_{}", k + 1), c)),
+                )
+                .map(|(k, v)| (k, port_text(v)))
+                .collect(),
+            Kind::Delay(ms) => vec![("delay_msec".into(), ms.to_string())],
+            Kind::RunOnce { then_skip } => vec![("then_skip".into(), then_skip.to_string())],
+            Kind::Precondition { code, otherwise } => vec![
+                ("if".into(), code.clone()),
+                ("else".into(), verdict_text(*otherwise).into()),
+            ],
             Kind::SubTree { ports, .. } | Kind::Leaf { ports, .. } => ports
                 .iter()
                 .filter(|(k, _)| k != "_autoremap")
@@ -328,6 +353,12 @@ impl Writer<'_, '_> {
             }
             _ => Vec::new(),
         };
+        // BT.CPP's `config().pre_conditions` and `post_conditions`.
+        ports.extend(
+            n.scripts
+                .given()
+                .map(|(a, code)| (a.to_owned(), code.to_owned())),
+        );
         if !matches!(n.kind, Kind::SubTree { .. }) {
             if let Some(m) = self.model(default_name(&n.kind)) {
                 for (k, d) in m.defaults() {

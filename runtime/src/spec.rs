@@ -124,6 +124,23 @@ impl NodeScripts {
         }
     }
 
+    /// The scripts given, with their attribute names, in BT.CPP's order.
+    pub fn given(&self) -> impl Iterator<Item = (&'static str, &str)> {
+        [
+            &self.failure_if,
+            &self.success_if,
+            &self.skip_if,
+            &self.while_,
+            &self.on_success,
+            &self.on_failure,
+            &self.post,
+            &self.on_halted,
+        ]
+        .into_iter()
+        .zip(NodeScripts::ATTRIBUTES)
+        .filter_map(|(s, a)| Some((a, s.as_deref()?)))
+    }
+
     pub fn is_empty(&self) -> bool {
         *self == NodeScripts::default()
     }

@@ -30,6 +30,10 @@ struct Run {
     status: char,
     /// The root's reset after the last tick (BT.CPP's tickRoot).
     reset: Option<Change>,
+    /// What BT.CPP threw out of the tick after the last one in `ticks`.
+    thrown: Option<String>,
+    /// btc's run: each node's registration ID, by preorder index.
+    ids: Vec<String>,
 }
 
 fn letter(s: Status) -> char {
@@ -42,7 +46,8 @@ fn letter(s: Status) -> char {
     }
 }
 
-/// A case: its XML, how many ticks at most, simulated or real ms per tick.
+/// A case: its XML (or `file PATH`: a file both load, includes and all),
+/// how many ticks at most, simulated or real ms per tick.
 struct Case {
     xml: String,
     ticks: u32,
@@ -57,7 +62,7 @@ fn run_btc(case: &Case) -> Result<Run, String> {
 
 /// [`run_btc`], with the run's `.btlog` as btc writes it.
 fn run_btc_logged(case: &Case) -> Result<(Run, Vec<u8>), String> {
-    let doc = xml::parse(&case.xml).map_err(|e| e.to_string())?;
+    let doc = tree_doc(case)?;
     let opts = Options {
         trace: true,
         ms_per_tick: case.tick_ms.max(1),
@@ -87,6 +92,8 @@ fn run_btc_logged(case: &Case) -> Result<(Run, Vec<u8>), String> {
         ticks: Vec::new(),
         status: 'R',
         reset: None,
+        thrown: None,
+        ids: e.meta.iter().map(|m| m.id.clone()).collect(),
     };
     let mut seen = 0;
     let mut last = Status::Running;
@@ -109,6 +116,28 @@ fn run_btc_logged(case: &Case) -> Result<(Run, Vec<u8>), String> {
     let log = btc_runtime::btlog::write(&doc, &e, last, case.tick_ms.max(1), 0)
         .map_err(|e| e.to_string())?;
     Ok((run, log))
+}
+
+/// The case's tree as btc reads it: from the text, or from the file with
+/// the files it includes (relative to each file, as `btc run --tree`).
+fn tree_doc(case: &Case) -> Result<btc_runtime::TreeDoc, String> {
+    use btc_runtime::include::{self, Opened};
+    let Some(path) = case.xml.strip_prefix("file ") else {
+        return xml::parse(&case.xml).map_err(|e| e.to_string());
+    };
+    let path = std::path::Path::new(path.trim());
+    let read = |p: &std::path::Path| std::fs::read_to_string(p).map_err(|e| e.to_string());
+    let mut open = |p: &std::path::Path| -> Result<Opened<()>, String> {
+        Ok(Opened {
+            file: (),
+            text: read(p)?,
+        })
+    };
+    let first = Opened {
+        file: (),
+        text: read(path)?,
+    };
+    include::load(path, first, &mut open).map_err(|e| e.error.to_string())
 }
 
 // ------------------------------------------------------------- BT.CPP
@@ -170,9 +199,19 @@ fn parse_runs(out: &str, n: usize) -> Vec<Result<Run, String>> {
                 ticks: Vec::new(),
                 status: 'R',
                 reset: None,
+                thrown: None,
+                ids: Vec::new(),
             })),
+            // Before the first tick: the tree is refused; after: the tick
+            // threw.
             Some("error") => {
-                *runs.last_mut().unwrap() = Err(line[6..].to_owned());
+                let last = runs.last_mut().unwrap();
+                match last {
+                    Ok(r) if !r.ticks.is_empty() || line.contains("Exception in node") => {
+                        r.thrown = Some(line[6..].to_owned());
+                    }
+                    _ => *last = Err(line[6..].to_owned()),
+                }
             }
             Some("tick") => {
                 if let Some(Ok(r)) = runs.last_mut() {
@@ -228,6 +267,63 @@ fn compare(case: &Case, btc: &Run, cpp: &Run) -> Result<(), String> {
         ));
     }
     Ok(())
+}
+
+/// Where BT.CPP 4.10 throws out of the tick, btc fails the node instead
+/// (docs/runtime.md, intended differences): IfThenElse whose condition was
+/// SKIPPED ("Something unexpected happened"), WhileDoElse whose condition
+/// was SKIPPED (it returns IDLE, and setting IDLE throws). The ticks before
+/// agree, and in the tick BT.CPP threw btc fails a node of that kind (for
+/// IfThenElse, the one BT.CPP names).
+fn compare_thrown(case: &Case, btc: &Run, cpp: &Run, what: &str) -> Result<(), String> {
+    let kind = if what.contains("Something unexpected happened in IfThenElseNode") {
+        "IfThenElse"
+    } else if what
+        .contains("Node [WhileDoElse]: you are not allowed to set manually the status to IDLE")
+    {
+        "WhileDoElse"
+    } else {
+        return Err(format!("BT.CPP threw: {what}\n{}", case.xml));
+    };
+    let t = cpp.ticks.len();
+    let before = Run {
+        ticks: btc.ticks.iter().take(t).cloned().collect(),
+        status: 'R',
+        reset: None,
+        thrown: None,
+        ids: Vec::new(),
+    };
+    let cpp_before = Run {
+        ticks: cpp.ticks.clone(),
+        status: 'R',
+        reset: None,
+        thrown: None,
+        ids: Vec::new(),
+    };
+    compare(case, &before, &cpp_before)?;
+    // `'Path/IfThenElse::UID' [IfThenElse]`: uids are preorder from 1.
+    let named = what
+        .split("' [")
+        .next()
+        .and_then(|p| p.rsplit("::").next())
+        .and_then(|uid| uid.parse::<u32>().ok())
+        .filter(|_| kind == "IfThenElse")
+        .map(|uid| uid - 1);
+    let failed = btc.ticks.get(t).into_iter().flatten().any(|&(n, _, to)| {
+        to == 'F'
+            && btc.ids.get(n as usize).is_some_and(|id| id == kind)
+            && named.is_none_or(|k| k == n)
+    });
+    if failed {
+        Ok(())
+    } else {
+        Err(format!(
+            "tick {}: BT.CPP threw ({what}); btc failed no {kind} there: {:?}\n{}",
+            t + 1,
+            btc.ticks.get(t),
+            case.xml
+        ))
+    }
 }
 
 // ---------------------------------------------------------- generator
@@ -506,18 +602,26 @@ fn check_all(cases: &[Case], name: &str) -> usize {
                 continue;
             }
         };
-        if cpp.status != 'R' {
+        if cpp.status != 'R' || cpp.thrown.is_some() {
             finished += 1;
         }
-        if let Err(e) = compare(case, &btc, cpp) {
+        let same = match &cpp.thrown {
+            Some(what) => compare_thrown(case, &btc, cpp, what),
+            None => compare(case, &btc, cpp),
+        };
+        if let Err(e) = same {
             failures.push(format!("case {i}: {e}"));
         }
     }
+    // Every difference, for classifying them: the message shows three.
+    let report = btc_testkit::target_dir("btcpp/conformance").join(format!("{name}.differences"));
+    let _ = std::fs::write(&report, failures.join("\n\n"));
     assert!(
         failures.is_empty(),
-        "{} of {} cases differ; the first:\n{}",
+        "{} of {} cases differ (all in {}); the first:\n{}",
         failures.len(),
         cases.len(),
+        report.display(),
         failures
             .iter()
             .take(3)
@@ -562,11 +666,10 @@ fn random_trees_run_tick_for_tick_as_in_btcpp() {
     random_batch("random", 10_000, 0x6274_6370_7034, false);
 }
 
-/// Not yet green: 61 of the 5,000 cases still differ (some where BT.CPP
-/// 4.10 throws: IfThenElse with a SKIPPED condition, WhileDoElse setting
-/// IDLE). Run with `--ignored`; the first differences are printed.
+/// Some of these trees make BT.CPP 4.10 throw (IfThenElse or WhileDoElse
+/// whose condition was SKIPPED): there btc fails the node, checked by
+/// [`compare_thrown`].
 #[test]
-#[ignore = "61 of 5,000 scripting cases still differ from BT.CPP 4.10"]
 fn random_trees_with_scripting_run_tick_for_tick_as_in_btcpp() {
     random_batch("scripting", 5_000, 0x7363_7269_7074, true);
 }
@@ -660,6 +763,51 @@ fn timeout_and_sleep_agree_when_the_clocks_agree() {
         ],
         "clock",
     );
+}
+
+#[test]
+fn where_btcpp_throws_on_a_skipped_condition_btc_fails_the_node() {
+    let Some(exe) = harness() else { return };
+    let cases = [
+        one(
+            r#"<Sequence><Scripted script="RS"/><IfThenElse><AlwaysSuccess _skipIf="true"/><Scripted script="S"/></IfThenElse></Sequence>"#,
+            5,
+            10,
+        ),
+        one(
+            r#"<Sequence><Scripted script="RS"/><WhileDoElse><AlwaysSuccess _skipIf="true"/><Scripted script="S"/></WhileDoElse></Sequence>"#,
+            5,
+            10,
+        ),
+    ];
+    let cpp = run_btcpp(&exe, &cases, "thrown");
+    for (case, cpp) in cases.iter().zip(&cpp) {
+        let cpp = cpp.as_ref().unwrap();
+        let what = cpp.thrown.as_deref().expect("BT.CPP 4.10 throws");
+        assert_eq!(cpp.ticks.len(), 1, "the first tick went through");
+        compare_thrown(case, &run_btc(case).unwrap(), cpp, what).unwrap();
+    }
+}
+
+/// `<include path>` as BT.CPP reads it (`createTreeFromFile`, paths
+/// relative to each including file) and as btc does: the same statuses
+/// tick by tick.
+#[test]
+fn included_files_run_as_in_btcpp() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/include");
+    let case = |file: &str, ticks| Case {
+        xml: format!("file {}", dir.join(file).display()),
+        ticks,
+        tick_ms: 0,
+    };
+    let cases = [case("btcpp/main.xml", 12), case("main.xml", 3)];
+    check_all(&cases, "include");
+    // Both finish, the included trees' scripts counted as the fixture says.
+    if let Some(exe) = harness() {
+        for run in run_btcpp(&exe, &cases, "include-status") {
+            assert_eq!(run.unwrap().status, 'S');
+        }
+    }
 }
 
 #[test]
@@ -777,11 +925,25 @@ fn read_btlog(b: &[u8]) -> (El, Vec<(u16, u8)>) {
 
 #[test]
 fn btc_run_btlog_has_the_structure_btcpp_filelogger2_writes() {
+    btlog_batch("btlog", 0x0062_746c_6f67, false);
+}
+
+/// With scripts: the nodes' pre- and post-condition attributes, Script's
+/// `code`, Switch's `variable` and `case_N`, RunOnce's `then_skip`,
+/// Precondition's `if` and `else` are in the tree as BT.CPP writes it.
+#[test]
+fn the_btlog_of_a_scripted_tree_carries_the_scripting_ports_as_btcpp_does() {
+    btlog_batch("btlog-scripting", 0x7362_746c_6f67, true);
+}
+
+/// 300 random trees, each run by btc (`.btlog` written by btc) and by
+/// BT.CPP (FileLogger2): the same XML and the same transitions.
+fn btlog_batch(name: &str, seed: u64, scripting: bool) {
     let Some(exe) = harness() else { return };
     let mut g = Gen {
-        rng: fastrand::Rng::with_seed(0x0062_746c_6f67),
+        rng: fastrand::Rng::with_seed(seed),
         subtrees: Vec::new(),
-        scripting: false,
+        scripting,
     };
     let cases: Vec<Case> = (0..300)
         .map(|_| Case {
@@ -790,9 +952,9 @@ fn btc_run_btlog_has_the_structure_btcpp_filelogger2_writes() {
             tick_ms: 0,
         })
         .collect();
-    let dir = btc_testkit::target_dir("btcpp/conformance/btlog");
+    let dir = btc_testkit::target_dir(&format!("btcpp/conformance/{name}"));
     let _ = std::fs::remove_dir_all(&dir);
-    let cpp = run_btcpp_logged(&exe, &cases, "btlog", Some(&dir));
+    let cpp = run_btcpp_logged(&exe, &cases, name, Some(&dir));
     let mut records = 0;
     for (i, (case, cpp)) in cases.iter().zip(&cpp).enumerate() {
         assert!(cpp.is_ok(), "case {i}: {cpp:?}");

@@ -127,6 +127,36 @@ fn a_script_that_fails_at_run_time_fails_its_node_with_the_reason() {
 }
 
 #[test]
+fn a_skipped_condition_fails_if_then_else_and_while_do_else_with_the_reason() {
+    let doc = xml::parse(&fixture("skipped_condition")).unwrap();
+    let opts = Options {
+        trace: true,
+        ..Options::default()
+    };
+    let mut e = Engine::build(&doc, None, opts).unwrap();
+    assert_eq!(e.run(10, |_| {}), Status::Failure);
+    assert_eq!(e.tick, 1);
+    let failed: Vec<(u32, &str)> = e
+        .trace
+        .iter()
+        .filter_map(|t| match t {
+            btc_runtime::engine::TraceItem::Status {
+                node,
+                to: Status::Failure,
+                ..
+            } => Some((*node, e.meta[*node as usize].name.as_str())),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(failed[..2], [(1, "if"), (4, "while")], "{failed:?}");
+    assert_eq!(e.records[0].node_name, "while");
+    assert_eq!(
+        e.records[0].reason,
+        "the condition of WhileDoElse was skipped"
+    );
+}
+
+#[test]
 fn malformed_trees_are_refused_with_their_codes() {
     let code = |name: &str| build(name).err().map(|e| (e.code.id, e.message));
     let (c, m) = code("bad_script").unwrap();

@@ -2,6 +2,7 @@
 //! {place})`) or an object name (`{color}_{type}_{k}`), parsed once and then
 //! filled in (to write a fact) or matched (to read one back).
 
+use btc_pddl::logic::{Atom, Formula};
 use serde::Serialize;
 use std::fmt;
 
@@ -93,15 +94,22 @@ impl fmt::Display for Literal {
     }
 }
 
-/// A conjunction of literals, printed as PDDL.
-pub fn conjunction(lits: &[Literal]) -> String {
-    match lits {
-        [one] => one.to_string(),
-        _ => {
-            let parts: Vec<String> = lits.iter().map(Literal::to_string).collect();
-            format!("(and {})", parts.join(" "))
+impl Literal {
+    /// The literal as a logic value, for the KB and the planner.
+    pub fn formula(&self) -> Formula {
+        let args: Vec<&str> = self.atom.args.iter().map(String::as_str).collect();
+        let atom = Formula::Atom(Atom::ground(&self.atom.pred, &args));
+        if self.positive {
+            atom
+        } else {
+            Formula::Not(Box::new(atom))
         }
     }
+}
+
+/// A conjunction of literals as one formula (the literal itself for one).
+pub fn conjunction(lits: &[Literal]) -> Formula {
+    Formula::conjunction(lits.iter().map(Literal::formula).collect()).unwrap_or_else(Formula::truth)
 }
 
 impl AtomTemplate {

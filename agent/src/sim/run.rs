@@ -1485,7 +1485,8 @@ impl<'w, 'd> Sim<'w, 'd> {
                 goal.push(lit);
             }
         }
-        let goal_text = conjunction(&goal);
+        let goal_f = conjunction(&goal);
+        let goal_text = goal_f.to_string();
         let robot = self.agents[a].robot;
         let robot_name = self.cell.robot(robot).object.clone();
         let mut attempt = Attempt {
@@ -1498,15 +1499,6 @@ impl<'w, 'd> Sim<'w, 'd> {
             planning_ms: 0.0,
             outcome: String::new(),
             challenges: Vec::new(),
-        };
-        let goal_f = match btc_pddl::logic::decode::formula(&goal_text) {
-            Ok(f) => f,
-            Err(m) => {
-                attempt.outcome = format!("failed: the goal is not PDDL: {m}");
-                self.tasks[t].attempts.push(attempt);
-                self.fail_task(t, format!("its goal `{goal_text}` is not PDDL: {m}"));
-                return;
-            }
         };
         // The goal must fit the domain (it is checked as the KB compiles it).
         match self.kb.formula(&goal_f) {

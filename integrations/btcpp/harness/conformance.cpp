@@ -6,6 +6,8 @@
 //   case NAME TICKS TICK_MS
 //   <root ...> ... </root>      (BT.CPP v4 XML, any number of lines)
 //   end
+// or, for a tree BT.CPP loads from a file (its <include>s read relative to
+// it), `file PATH` in place of the XML.
 // Leaves `Scripted` return the letters of their `script` port in turn
 // (S: SUCCESS, F: FAILURE, R: RUNNING; cycling; empty or missing: FAILURE).
 // The tree is ticked with Tree::tickExactlyOnce until it stops RUNNING or
@@ -143,7 +145,12 @@ void runCase(const std::string& name, long ticks, long tick_ms, const std::strin
   {
     BT::BehaviorTreeFactory factory;
     factory.registerNodeType<Scripted>("Scripted");
-    auto tree = factory.createTreeFromText(xml);
+    const std::string file_prefix = "file ";
+    auto tree = xml.rfind(file_prefix, 0) == 0 ?
+                    factory.createTreeFromFile(xml.substr(file_prefix.size(),
+                                                          xml.find_last_not_of(" \n") + 1 -
+                                                              file_prefix.size())) :
+                    factory.createTreeFromText(xml);
     std::map<const BT::TreeNode*, int> index;
     BT::applyRecursiveVisitor(static_cast<const BT::TreeNode*>(tree.rootNode()),
                               [&](const BT::TreeNode* n) {

@@ -9,7 +9,11 @@ use super::{Arg, Engine, NodeDef, Op, Status};
 impl<'w> Engine<'w> {
     /// The decorators that map their child's status.
     pub(super) fn tick_wrapper(&mut self, i: u32, def: NodeDef) -> Status {
-        self.set(i as usize, Status::Running);
+        // BT.CPP's SubTree becomes RUNNING only from IDLE: one ticked again
+        // after it finished (WhileDoElse's condition) keeps its status.
+        if def.op != Op::SubTree || self.status[i as usize] == Status::Idle {
+            self.set(i as usize, Status::Running);
+        }
         let c = self.kid(def, 0);
         let s = self.tick_node(c);
         if s.is_done() {

@@ -64,7 +64,11 @@ impl<'w> Engine<'w> {
                 self.tick_node(c)
             }
             Status::Failure => Status::Failure,
-            other => other,
+            // BT.CPP 4.10 returns IDLE here, and setting IDLE throws.
+            _ => {
+                self.reset_children(def, 0);
+                return self.fail(i, "the condition of WhileDoElse was skipped");
+            }
         };
         if s != Status::Running {
             self.reset_children(def, 0);

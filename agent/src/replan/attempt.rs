@@ -1,0 +1,177 @@
+//! One attempt: the plan compiled with the rules, exactly as `btc compile`
+//! compiles the plan file, and the tree run in the carried world until it
+//! ends, a high-priority order preempts it, or the ticks run out.
+
+use super::carry::goal_formula;
+use super::planning::Planned;
+use super::{push_event, Attempt, LoopError, Run};
+use btc_lang::db;
+use btc_pddl::logic::Formula;
+use btc_runtime::engine::{Engine, FaultRecord, Status};
+use btc_runtime::faults::FaultKind;
+use btc_runtime::{Kb, TreeDoc};
+use std::time::Instant;
+
+/// What an attempt's run ended in, for deciding what comes next.
+pub(super) struct Ran {
+    pub status: Status,
+    /// The tree succeeded and no order preempted it.
+    pub done: bool,
+    pub preempted: bool,
+    /// The goals of the orders that preempted the tree.
+    pub preempting: Vec<Formula>,
+    /// The high-priority-order faults met at the attempt's last tick.
+    pub order_faults: Vec<String>,
+    /// Parts discarded by faults, with the fault: (part, fault).
+    pub discarded: Vec<(String, String)>,
+    /// Goals faults added during this attempt.
+    pub added: Vec<Formula>,
+    pub end_tick: u64,
+    /// The last fault record: the failure the loop replans after.
+    pub last_record: Option<FaultRecord>,
+}
+
+impl Run<'_> {
+    /// Compiles and runs attempt `attempt` for `goal`, and records it.
+    pub(super) fn attempt(
+        &mut self,
+        attempt: usize,
+        goal: &Formula,
+        planned: Planned,
+        for_priority: bool,
+    ) -> Result<Ran, LoopError> {
+        let (planned_text, planning_ms, expanded) = match planned {
+            Planned::Made { text, ms, expanded } => (Some(text), ms, expanded),
+            _ => (None, 0.0, 0),
+        };
+        let source = if planned_text.is_some() {
+            "planned"
+        } else {
+            "given"
+        };
+        if let Some(text) = planned_text {
+            self.db.set_file(&self.plan_path, text);
+        }
+        let tc = Instant::now();
+        let ir = db::compile(self.db, self.job).as_ref().map_err(|e| {
+            let mut e = e.clone();
+            if e.is_empty() {
+                e = db::job_diagnostics(self.db, self.job)
+                    .iter()
+                    .filter(|d| d.is_error())
+                    .cloned()
+                    .collect();
+            }
+            LoopError::Compile(e)
+        })?;
+        let doc = TreeDoc::from_ir(ir);
+        let compile_ms = tc.elapsed().as_secs_f64() * 1e3;
+        let plan: Vec<String> = ir.steps.iter().map(|s| s.display()).collect();
+        let goal_text = goal.to_string();
+        let trace = self.opts.engine.trace;
+        if trace {
+            push_event(
+                self.trace_out,
+                serde_json::json!({
+                    "event": "plan", "attempt": attempt, "tick": self.carry.tick,
+                    "source": source, "goal": goal_text, "steps": plan,
+                }),
+            );
+        }
+        // Run, in the carried world.
+        let mut kb = self.carry.kb(&self.world);
+        let g = goal_formula(&mut kb, goal)?;
+        kb.set_goal(g);
+        let mut engine =
+            Engine::build(&doc, Some(kb), self.opts.engine.clone()).map_err(LoopError::Tree)?;
+        engine.tick = self.carry.tick;
+        match self.carry.faults.take() {
+            Some(f) => engine.restore_faults(f),
+            None => {
+                if let Some(s) = self.scenario {
+                    engine.add_faults(s).map_err(LoopError::Scenario)?;
+                }
+            }
+        }
+        let start_tick = engine.tick;
+        let tr = Instant::now();
+        let trace_out = &mut *self.trace_out;
+        // A high-priority order whose goal does not hold preempts the plan.
+        let (status, preempted) = engine.run_until(self.opts.max_ticks, |e| {
+            if trace {
+                let _ = e.drain_trace(trace_out);
+            }
+            e.kb.as_ref()
+                .is_some_and(|kb| !kb.unmet_extra_goals().is_empty())
+        });
+        let run_ms = tr.elapsed().as_secs_f64() * 1e3;
+        let sum = engine.summary(status);
+        let done = !preempted && sum.success();
+        let end_tick = engine.tick;
+        let waited = if done || (status == Status::Running && !preempted) {
+            0
+        } else {
+            engine.wait_for_faults(self.opts.max_ticks)
+        };
+        let preempting: Vec<Formula> = if preempted {
+            engine
+                .kb
+                .as_ref()
+                .map(Kb::unmet_extra_goals)
+                .unwrap_or_default()
+        } else {
+            Vec::new()
+        };
+        let order_faults: Vec<String> = sum
+            .faults
+            .iter()
+            .filter(|f| f.kind == FaultKind::HighPriorityOrder && f.met_at == Some(end_tick))
+            .map(|f| f.fault.clone())
+            .collect();
+        self.out.faults = engine.fault_outcomes(done);
+        if trace {
+            let _ = engine.drain_trace(self.trace_out);
+        }
+        let discarded = engine.discarded_parts();
+        let kb = engine.kb.as_mut().expect("built with a KB");
+        let mut added = kb.extra_goals();
+        added.retain(|a| !self.carry.extra_goals.contains(a));
+        self.carry.extra_goals.extend(added.iter().cloned());
+        let (goal_ok, goal_why) = kb.goal();
+        self.carry.state = Some(std::mem::take(&mut kb.state));
+        self.carry.tick = engine.tick;
+        self.carry.faults = Some(engine.take_faults());
+        self.out.ticks = self.carry.tick;
+        self.out.goal_reached = goal_ok && done && !for_priority;
+        self.out.goal_failure = goal_why;
+        self.out.attempts.push(Attempt {
+            attempt,
+            source,
+            goal: goal_text,
+            plan,
+            planning_ms,
+            expanded,
+            compile_ms,
+            run_ms,
+            start_tick,
+            end_tick,
+            status,
+            steps_done: sum.steps_done,
+            steps_total: sum.steps_total,
+            records: sum.records.clone(),
+            waited_ticks: waited,
+            preempted,
+        });
+        Ok(Ran {
+            status,
+            done,
+            preempted,
+            preempting,
+            order_faults,
+            discarded,
+            added,
+            end_tick,
+            last_record: sum.records.last().cloned(),
+        })
+    }
+}
