@@ -228,6 +228,24 @@ pub fn parsed_rules(db: &dyn Db, file: SourceFile) -> ParsedRules {
     })
 }
 
+/// A rules file's tokens and comments (spans in file 0: positions, not
+/// places), lexed once per text: every language server request reads
+/// them, and lexing a huge file per request cost a large part of each.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FileTokens {
+    pub tokens: Vec<(crate::rules::lexer::Tok, Span)>,
+    pub comments: Vec<crate::rules::lexer::Comment>,
+}
+
+#[salsa::tracked(returns(ref))]
+pub fn rules_tokens(db: &dyn Db, file: SourceFile) -> FileTokens {
+    let l = crate::rules::lexer::lex(file.text(db), 0);
+    FileTokens {
+        tokens: l.tokens,
+        comments: l.comments,
+    }
+}
+
 /// Whether an imported file is a BT.CPP node palette (`.xml`) rather than
 /// rules.
 pub fn is_palette(path: &FilePath) -> bool {

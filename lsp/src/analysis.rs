@@ -61,7 +61,7 @@ impl<'a> Analysis<'a> {
             domain,
             syntax: FileSyntax {
                 text,
-                tokens: Tokens::new(text),
+                tokens: Tokens::of(btc_lang::db::rules_tokens(db, file)),
                 items,
             },
             lines: std::cell::OnceCell::new(),

@@ -67,7 +67,7 @@ pub fn classified(a: &Analysis) -> Vec<(Span, SemanticTokenType)> {
         }
     }
     let mut out = Vec::new();
-    for (tok, span) in &a.syntax.tokens.toks {
+    for (tok, span) in a.syntax.tokens.toks {
         let ty = match tok {
             Tok::Str(_) => Some(SemanticTokenType::STRING),
             Tok::Int(_) | Tok::Float(_) => Some(SemanticTokenType::NUMBER),
@@ -82,7 +82,7 @@ pub fn classified(a: &Analysis) -> Vec<(Span, SemanticTokenType)> {
             out.push((*span, t));
         }
     }
-    for c in &a.syntax.tokens.comments {
+    for c in a.syntax.tokens.comments {
         out.push((c.span, SemanticTokenType::COMMENT));
     }
     out.sort_by_key(|(s, _)| s.start);

@@ -107,16 +107,51 @@ fn convert_file(
 ) -> Option<(Url, Vec<tower_lsp::lsp_types::Diagnostic>, Option<i32>)> {
     let uri = Url::from_file_path(fd.path.as_path()?).ok()?;
     let text = ws.text(&fd.path).unwrap_or_default();
-    let ix = LineIndex::new(text);
+    let lines = Lines::new(ws, LineIndex::new(text));
     let capped =
         btc_pddl::render::capped(&fd.diagnostics, btc_pddl::limits::MAX_DIAGNOSTICS_PER_FILE);
-    let diags = capped.iter().map(|d| to_lsp(ws, &ix, d)).collect();
+    let diags = capped.iter().map(|d| to_lsp(&lines, d)).collect();
     Some((uri, diags, fd.version))
+}
+
+/// Line indexes for converting one file's diagnostics: the file's own, and
+/// one per other file a label points into, each built once. (Building one
+/// per label made publishing a huge file's diagnostics take seconds.)
+pub struct Lines<'a> {
+    ws: &'a Workspace,
+    own: LineIndex<'a>,
+    others: std::cell::RefCell<
+        std::collections::HashMap<btc_pddl::source::FileId, Option<(Url, LineIndex<'a>)>>,
+    >,
+}
+
+impl<'a> Lines<'a> {
+    /// `own` indexes the text the diagnostics' primary spans are in.
+    pub fn new(ws: &'a Workspace, own: LineIndex<'a>) -> Lines<'a> {
+        Lines {
+            ws,
+            own,
+            others: std::cell::RefCell::new(std::collections::HashMap::new()),
+        }
+    }
+
+    /// The location of a span in any file of the workspace.
+    fn location(&self, span: btc_pddl::source::Span) -> Option<Location> {
+        let mut others = self.others.borrow_mut();
+        let entry = others.entry(span.file).or_insert_with(|| {
+            let path = self.ws.path_of(span.file)?;
+            let uri = Url::from_file_path(path.as_path()?).ok()?;
+            let text = self.ws.text(&path)?;
+            Some((uri, LineIndex::new(text)))
+        });
+        let (uri, ix) = entry.as_ref()?;
+        Some(Location::new(uri.clone(), ix.range(span)))
+    }
 }
 
 /// A btc diagnostic as LSP sees it: range, code, message with its hint,
 /// secondary labels as related information.
-pub fn to_lsp(ws: &Workspace, ix: &LineIndex, d: &Diagnostic) -> tower_lsp::lsp_types::Diagnostic {
+pub fn to_lsp(lines: &Lines, d: &Diagnostic) -> tower_lsp::lsp_types::Diagnostic {
     let mut message = d.message.clone();
     if let Some(h) = &d.hint {
         message.push_str("\nhint: ");
@@ -126,17 +161,14 @@ pub fn to_lsp(ws: &Workspace, ix: &LineIndex, d: &Diagnostic) -> tower_lsp::lsp_
         .labels
         .iter()
         .filter_map(|l| {
-            let path = ws.path_of(l.span.file)?;
-            let uri = Url::from_file_path(path.as_path()?).ok()?;
-            let text = ws.text(&path)?;
             Some(DiagnosticRelatedInformation {
-                location: Location::new(uri, LineIndex::new(text).range(l.span)),
+                location: lines.location(l.span)?,
                 message: l.message.clone(),
             })
         })
         .collect();
     tower_lsp::lsp_types::Diagnostic {
-        range: ix.range(d.span),
+        range: lines.own.range(d.span),
         severity: Some(match d.severity {
             Severity::Error => DiagnosticSeverity::ERROR,
             Severity::Warning => DiagnosticSeverity::WARNING,
@@ -416,8 +448,8 @@ impl LanguageServer for Backend {
     async fn code_action(&self, p: CodeActionParams) -> Result<Option<CodeActionResponse>> {
         let uri = p.text_document.uri.clone();
         self.with_analysis(&p.text_document.uri, |a| {
-            let ix = a.line_index();
-            let conv = |d: &Diagnostic| to_lsp(a.ws, ix, d);
+            let lines = Lines::new(a.ws, LineIndex::new(a.text));
+            let conv = |d: &Diagnostic| to_lsp(&lines, d);
             Some(
                 edits::code_actions(a, &uri, p.range, &conv)
                     .into_iter()

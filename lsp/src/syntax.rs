@@ -4,7 +4,7 @@
 //! means is the checker's (`btc_lang::resolutions`), not worked out here.
 
 use btc_lang::rules::ast::ItemNode;
-use btc_lang::rules::lexer::{lex, Comment, Tok};
+use btc_lang::rules::lexer::{Comment, Tok};
 use btc_pddl::source::Span;
 
 /// Item keywords: a name after one of these is being declared.
@@ -39,18 +39,18 @@ pub const OTHER_KEYWORDS: &[&str] = &[
     "backchained",
 ];
 
-/// The tokens of a file with absolute spans, and its comments.
-pub struct Tokens {
-    pub toks: Vec<(Tok, Span)>,
-    pub comments: Vec<Comment>,
+/// The tokens of a file with absolute spans, and its comments (lexed once
+/// per text by the database: `btc_lang::db::rules_tokens`).
+pub struct Tokens<'a> {
+    pub toks: &'a [(Tok, Span)],
+    pub comments: &'a [Comment],
 }
 
-impl Tokens {
-    pub fn new(text: &str) -> Tokens {
-        let l = lex(text, 0);
+impl<'a> Tokens<'a> {
+    pub fn of(t: &'a btc_lang::db::FileTokens) -> Tokens<'a> {
         Tokens {
-            toks: l.tokens,
-            comments: l.comments,
+            toks: &t.tokens,
+            comments: &t.comments,
         }
     }
 
@@ -166,7 +166,7 @@ pub fn is_keyword(word: &str) -> bool {
 /// A file's tokens with its parsed items.
 pub struct FileSyntax<'a> {
     pub text: &'a str,
-    pub tokens: Tokens,
+    pub tokens: Tokens<'a>,
     pub items: &'a [ItemNode],
 }
 

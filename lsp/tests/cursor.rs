@@ -309,9 +309,8 @@ fn run(feature: &str, name: &str) {
         "code_actions" => {
             let uri = Url::from_file_path(c.path.as_path().unwrap()).unwrap();
             let at = a.line_index().position(c.offset);
-            let conv = |d: &btc_pddl::diagnostic::Diagnostic| {
-                btc_lsp::server::to_lsp(a.ws, a.line_index(), d)
-            };
+            let lines = btc_lsp::server::Lines::new(a.ws, btc_lsp::convert::LineIndex::new(a.text));
+            let conv = |d: &btc_pddl::diagnostic::Diagnostic| btc_lsp::server::to_lsp(&lines, d);
             let actions = edits::code_actions(&a, &uri, Range::new(at, at), &conv);
             let mut out = String::new();
             for act in &actions {

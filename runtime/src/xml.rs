@@ -7,7 +7,9 @@
 
 use crate::engine::MAX_DEPTH;
 use crate::error::LoadError;
-use crate::spec::{Amount, Kind, NodeScripts, SNode, StepConditions, TreeDoc, Verdict};
+use crate::spec::{
+    default_name, Amount, Kind, NodeScripts, SNode, StepConditions, TreeDoc, Verdict,
+};
 use btc_ir::{LeafKind, NodeModel, PortDirection, PortModel, PortValue};
 use btc_pddl::diagnostic::{codes, did_you_mean};
 use btc_pddl::logic::decode;
@@ -21,25 +23,63 @@ fn syntax(msg: impl Into<String>, at: usize) -> LoadError {
 struct Elem {
     name: String,
     attrs: Vec<(String, String)>,
+    /// Where each attribute's name is, by name (kept when `attrs` is taken
+    /// apart): diagnostics about an attribute point at it.
+    attr_at: Vec<(String, usize)>,
+    /// Where the element's `<` is.
     at: usize,
+}
+
+/// Where `part`, a slice of the element `e` (whose `<` is at `at`), is in
+/// the file. quick-xml gives attributes no positions, but a reader of a
+/// `&str` hands out slices of it, so the distance from the element's own
+/// bytes is the position; `at` when `part` is not such a slice.
+fn offset_in(e: &BytesStart, part: &[u8], at: usize) -> usize {
+    let base = e.as_ptr() as usize;
+    let p = part.as_ptr() as usize;
+    if p >= base && p + part.len() <= base + e.len() {
+        at + 1 + (p - base)
+    } else {
+        at
+    }
 }
 
 fn elem(e: &BytesStart, r: &Reader<&[u8]>, at: usize) -> Result<Elem, LoadError> {
     let name = String::from_utf8_lossy(e.name().as_ref()).into_owned();
     let mut attrs = Vec::new();
+    let mut attr_at = Vec::new();
     for a in e.attributes() {
         let a = a.map_err(|err| syntax(format!("a bad attribute in <{name}>: {err}"), at))?;
         let key = String::from_utf8_lossy(a.key.as_ref()).into_owned();
+        attr_at.push((key.clone(), offset_in(e, a.key.as_ref(), at)));
         let value = a
             .decode_and_unescape_value(r.decoder())
             .map_err(|err| syntax(format!("a bad attribute value in <{name}>: {err}"), at))?
             .into_owned();
         attrs.push((key, value));
     }
-    Ok(Elem { name, attrs, at })
+    Ok(Elem {
+        name,
+        attrs,
+        attr_at,
+        at,
+    })
 }
 
 impl Elem {
+    /// Where attribute `k`'s name is (the element's `<` without it).
+    fn attr_at(&self, k: &str) -> usize {
+        self.attr_at
+            .iter()
+            .find(|(a, _)| a == k)
+            .map_or(self.at, |(_, at)| *at)
+    }
+
+    /// Where the element's tag name is.
+    fn name_at(&self) -> usize {
+        self.at + 1
+    }
+
     fn get(&self, k: &str) -> Option<&str> {
         self.attrs
             .iter()
@@ -121,7 +161,7 @@ fn node_scripts(e: &mut Elem) -> Result<NodeScripts, LoadError> {
                     codes::X_UNSUPPORTED,
                     format!("<{}>: the attribute `{k}` is not one btc runs", e.name),
                 )
-                .at(e.at);
+                .at(e.attr_at(&k));
                 err = err.hint(match did_you_mean(&k, known) {
                     Some(h) => h,
                     None => "btc runs the pre- and post-conditions `_failureIf`, `_successIf`, `_skipIf`, `_while`, `_onSuccess`, `_onFailure`, `_post` and `_onHalted`, and SubTree's `_autoremap`".into(),
@@ -194,7 +234,7 @@ fn node_of(mut e: Elem) -> Result<SNode, LoadError> {
                 e.name
             ),
         )
-        .at(e.at)
+        .at(e.name_at())
         .hint("docs/runtime.md lists the nodes btc runs"));
     }
     let name = e.get("name").map(str::to_owned);
@@ -347,6 +387,7 @@ fn node_of(mut e: Elem) -> Result<SNode, LoadError> {
             }
         }
     };
+    check_scripts(&e, &kind, &scripts)?;
     Ok(SNode {
         kind,
         name,
@@ -354,6 +395,31 @@ fn node_of(mut e: Elem) -> Result<SNode, LoadError> {
         scripts,
         at: Some(e.at),
     })
+}
+
+/// The node's scripts parse (X040 at the attribute that holds the one that
+/// does not), checked here where the file's positions are known; the engine
+/// compiles them when it builds the tree.
+fn check_scripts(e: &Elem, kind: &Kind, scripts: &NodeScripts) -> Result<(), LoadError> {
+    let code = match kind {
+        Kind::Precondition { code, .. } => Some(("if", code.as_str())),
+        Kind::Leaf { id, ports, .. } if id == "Script" || id == "ScriptCondition" => {
+            ports.iter().find_map(|(k, v)| match v {
+                PortValue::Text(t) if k == "code" => Some(("code", t.as_str())),
+                _ => None,
+            })
+        }
+        _ => None,
+    };
+    for (attr, text) in scripts.given().chain(code) {
+        if let Err(err) = crate::script::parse(text) {
+            return Err(
+                crate::script::syntax_error(default_name(kind), attr, text, &err)
+                    .at(e.attr_at(attr)),
+            );
+        }
+    }
+    Ok(())
 }
 
 /// A PDDL attribute decoded (empty or absent: `None`); X005 when it is no
@@ -583,7 +649,7 @@ pub fn parse_file(text: &str) -> Result<Parsed, LoadError> {
                                 codes::X_UNSUPPORTED,
                                 "<include ros_pkg>: btc does not look up ROS packages",
                             )
-                            .at(at)
+                            .at(e.attr_at("ros_pkg"))
                             .hint("give `path` relative to this file, without `ros_pkg`"));
                         }
                         let path = e.get("path").map(str::trim).filter(|p| !p.is_empty());
@@ -738,8 +804,39 @@ mod tests {
         assert_eq!(e.code.id, "X001");
         let e = parse("<root><include path=\"x.xml\"/></root>").unwrap_err();
         assert_eq!(e.code.id, "X042");
-        let e = parse("<root><include ros_pkg=\"p\" path=\"x.xml\"/></root>").unwrap_err();
+        let text = "<root><include path=\"x.xml\" ros_pkg=\"p\"/></root>";
+        let e = parse(text).unwrap_err();
         assert_eq!(e.code.id, "X041");
+        assert_eq!(&text[e.offset.unwrap()..][..9], "ros_pkg=\"");
+    }
+
+    #[test]
+    fn script_errors_point_at_their_attribute() {
+        // Attribute values with entities and multi-byte text before: the
+        // position is the attribute's name, in bytes of the file.
+        let text = "<root BTCPP_format=\"4\"><BehaviorTree ID=\"M\">\n<Sequence name=\"é&gt;\" _skipIf=\"a &gt; = 1\">\n<Script code=\"x := 1\"/><AlwaysSuccess _onSucces=\"x := 2\"/></Sequence></BehaviorTree></root>";
+        let e = parse(text).unwrap_err();
+        assert_eq!(e.code.id, "X040");
+        assert_eq!(&text[e.offset.unwrap()..][..8], "_skipIf=");
+        assert!(
+            e.message.starts_with("`_skipIf` of `Sequence`: "),
+            "{}",
+            e.message
+        );
+        let text = text.replace("a &gt; = 1", "a &gt; 1");
+        let e = parse(&text).unwrap_err();
+        assert_eq!(e.code.id, "X041");
+        assert_eq!(&text[e.offset.unwrap()..][..10], "_onSucces=");
+        let text = text
+            .replace("_onSucces", "_onSuccess")
+            .replace("x := 1", "x :=");
+        let e = parse(&text).unwrap_err();
+        assert_eq!(e.code.id, "X040");
+        assert_eq!(&text[e.offset.unwrap()..][..5], "code=");
+        let text = "<root BTCPP_format=\"4\"><BehaviorTree ID=\"M\"><Precondition else=\"FAILURE\" if=\"((\"><AlwaysSuccess/></Precondition></BehaviorTree></root>";
+        let e = parse(text).unwrap_err();
+        assert_eq!(e.code.id, "X040");
+        assert_eq!(&text[e.offset.unwrap()..][..3], "if=");
     }
 
     #[test]
@@ -750,6 +847,7 @@ mod tests {
             );
             let e = parse(&text).unwrap_err();
             assert_eq!(e.code.id, "X041", "{id}");
+            assert_eq!(&text[e.offset.unwrap()..][..id.len()], id, "the tag name");
             assert_eq!(
                 e.message,
                 format!("<{id}> is a BehaviorTree.CPP 4.10 node btc does not run")

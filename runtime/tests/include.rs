@@ -88,6 +88,18 @@ fn an_error_in_an_included_file_is_reported_in_that_file() {
 }
 
 #[test]
+fn a_script_that_does_not_parse_in_an_included_file_is_reported_at_its_attribute_there() {
+    let mut names = Vec::new();
+    let err = load(&fixtures().join("bad_script_inner.xml"), &mut names).unwrap_err();
+    let file = &names[err.file];
+    assert!(file.ends_with("parts/bad_script.xml"), "{}", file.display());
+    assert_eq!(err.error.code.id, "X040");
+    let text = std::fs::read_to_string(file).unwrap();
+    let at = err.error.offset.unwrap();
+    assert!(text[at..].starts_with("_skipIf="), "{}", &text[at..]);
+}
+
+#[test]
 fn a_tree_defined_twice_across_files_is_refused() {
     let (code, message, _) = refused("twice.xml");
     assert_eq!(code, "X001");

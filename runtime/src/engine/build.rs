@@ -592,12 +592,7 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
         scope: &mut Scope,
     ) -> Result<u32, LoadError> {
         let script = crate::script::parse(text).map_err(|e| {
-            self.err(
-                codes::X_SCRIPT,
-                n,
-                format!("`{what}` of `{}`: {e}", default_name(&n.kind)),
-            )
-            .hint(format!("the script is `{text}`; BT.CPP's scripting language is described in docs/runtime.md"))
+            crate::script::syntax_error(default_name(&n.kind), what, text, &e).at_opt(n.at)
         })?;
         let slots = script.vars.iter().map(|v| self.slot_in(scope, v)).collect();
         self.e.scripts.push(CompiledScript {

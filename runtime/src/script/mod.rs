@@ -101,3 +101,20 @@ pub fn as_bool(v: &crate::engine::Value) -> Result<bool, ScriptError> {
         _ => Err(no()),
     }
 }
+
+/// X040 for `text`, the script in attribute (or port) `attr` of node `node`,
+/// that does not parse.
+pub(crate) fn syntax_error(
+    node: &str,
+    attr: &str,
+    text: &str,
+    e: &ScriptError,
+) -> crate::error::LoadError {
+    crate::error::LoadError::new(
+        btc_pddl::diagnostic::codes::X_SCRIPT,
+        format!("`{attr}` of `{node}`: {e}"),
+    )
+    .hint(format!(
+        "the script is `{text}`; BT.CPP's scripting language is described in docs/runtime.md"
+    ))
+}
