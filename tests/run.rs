@@ -472,3 +472,16 @@ fn scripts_in_the_rules_run_the_same_from_the_ir_and_the_xml() {
         assert_eq!(got, expected, "{what}");
     }
 }
+
+/// `btc fmt` keeps scripts: the fixture is in canonical layout, so a
+/// formatter that dropped or rewrote a `[skip_if: ...]` or a `script` leaf
+/// would make `--check` fail.
+#[test]
+fn fmt_keeps_the_scripts_of_a_rules_file() {
+    let out = btc(&["fmt", "--check", "tests/fixtures/scripts/rules.btrules"]);
+    exits(
+        &out,
+        0,
+        "btc fmt --check tests/fixtures/scripts/rules.btrules",
+    );
+}
