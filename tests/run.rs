@@ -337,29 +337,15 @@ fn commands_of(args: &[&str], what: &str) -> Vec<serde_json::Value> {
         .collect()
 }
 
-/// Every value a step computes (table lookups passed to a tree, strings
-/// interpolating them) reaches btc's engine the same way from the rules,
-/// from the JSON IR, and from the BT.CPP XML in SubTree mode and inlined.
-#[test]
-fn computed_values_reach_the_engine_from_the_ir_and_from_the_xml() {
+/// The rules compiled to the JSON IR, to BT.CPP XML and to inlined XML each
+/// run to `expected`'s commands in `problem`.
+fn same_commands_from_the_ir_and_the_xml(
+    rules: &str,
+    plan: &str,
+    problem: &str,
+    expected: &[serde_json::Value],
+) {
     let dir = tempfile::tempdir().unwrap();
-    let rules = "tests/fixtures/emit/values/rules.btrules";
-    let plan = "tests/fixtures/emit/values/plan.txt";
-    let problem = "tests/fixtures/emit/values/problem.pddl";
-    let expected = commands_of(&["run", rules, "--plan", plan], "rules");
-    let say: Vec<&serde_json::Value> = expected.iter().filter(|c| c[1] == "Say").collect();
-    assert_eq!(
-        say.iter().map(|c| c[2].clone()).collect::<Vec<_>>(),
-        [
-            serde_json::json!([["text", "holding battery_red at 5 N"]]),
-            serde_json::json!([["text", "holding pump_blue at 8 N"]]),
-        ]
-    );
-    assert!(expected.contains(&serde_json::json!([
-        6,
-        "ChangeGripper",
-        [["robot", "floor_robot"], ["gripper", "tray_gripper"]]
-    ])));
     for (what, emit, extra) in [
         ("json", "json", None),
         ("xml", "btcpp", None),
@@ -380,6 +366,31 @@ fn computed_values_reach_the_engine_from_the_ir_and_from_the_xml() {
         );
         assert_eq!(got, expected, "{what}");
     }
+}
+
+/// Every value a step computes (table lookups passed to a tree, strings
+/// interpolating them) reaches btc's engine the same way from the rules,
+/// from the JSON IR, and from the BT.CPP XML in SubTree mode and inlined.
+#[test]
+fn computed_values_reach_the_engine_from_the_ir_and_from_the_xml() {
+    let rules = "tests/fixtures/emit/values/rules.btrules";
+    let plan = "tests/fixtures/emit/values/plan.txt";
+    let problem = "tests/fixtures/emit/values/problem.pddl";
+    let expected = commands_of(&["run", rules, "--plan", plan], "rules");
+    let say: Vec<&serde_json::Value> = expected.iter().filter(|c| c[1] == "Say").collect();
+    assert_eq!(
+        say.iter().map(|c| c[2].clone()).collect::<Vec<_>>(),
+        [
+            serde_json::json!([["text", "holding battery_red at 5 N"]]),
+            serde_json::json!([["text", "holding pump_blue at 8 N"]]),
+        ]
+    );
+    assert!(expected.contains(&serde_json::json!([
+        6,
+        "ChangeGripper",
+        [["robot", "floor_robot"], ["gripper", "tray_gripper"]]
+    ])));
+    same_commands_from_the_ir_and_the_xml(rules, plan, problem, &expected);
 }
 
 #[test]
@@ -439,7 +450,6 @@ fn a_step_redone_after_a_fault_re_establishes_its_effects() {
 /// mode and inlined.
 #[test]
 fn scripts_in_the_rules_run_the_same_from_the_ir_and_the_xml() {
-    let dir = tempfile::tempdir().unwrap();
     let rules = "tests/fixtures/scripts/rules.btrules";
     let plan = "tests/fixtures/scripts/plan.txt";
     let problem = "tests/fixtures/emit/values/problem.pddl";
@@ -451,26 +461,7 @@ fn scripts_in_the_rules_run_the_same_from_the_ir_and_the_xml() {
         .collect();
     assert_eq!(said, ["moved once"; 4], "{expected:?}");
     assert_eq!(expected.iter().filter(|c| c[1] == "Grip").count(), 2);
-    for (what, emit, extra) in [
-        ("json", "json", None),
-        ("xml", "btcpp", None),
-        ("inlined xml", "btcpp", Some("--inline")),
-    ] {
-        let tree = dir.path().join(format!("tree_{emit}_{}", extra.is_some()));
-        let extra: Vec<&str> = extra.into_iter().collect();
-        compile(rules, plan, emit, &tree, &extra);
-        let got = commands_of(
-            &[
-                "run",
-                "--tree",
-                tree.to_str().unwrap(),
-                "--problem",
-                problem,
-            ],
-            what,
-        );
-        assert_eq!(got, expected, "{what}");
-    }
+    same_commands_from_the_ir_and_the_xml(rules, plan, problem, &expected);
 }
 
 /// `btc fmt` keeps scripts: the fixture is in canonical layout, so a
