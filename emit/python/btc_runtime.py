@@ -900,6 +900,41 @@ class Timeout(_Decorator):
         yield from self._end(s)
 
 
+class Delay(_Decorator):
+    """BT.CPP Delay: RUNNING until `ms` milliseconds of the knowledge base's
+    clock have passed since it started (the child untouched), then the
+    child's status; the delay starts again after the child finishes."""
+
+    def __init__(self, name, child, ms):
+        super().__init__(name=name, child=child)
+        self.ms = ms
+        self.until = None
+        self.blackboard = self.attach_blackboard_client(name=name)
+        self.blackboard.register_key(key=KB_KEY, access=READ)
+
+    def initialise(self):
+        self.until = None
+
+    def tick(self):
+        now = self.blackboard.get(KB_KEY).now_ms()
+        if self.status != Status.RUNNING:
+            self.initialise()
+        if self.until is None:
+            # The delay starts now; the child is ticked on a later tick.
+            self.until = now + self.ms
+            yield from self._end(Status.RUNNING)
+            return
+        if now < self.until:
+            yield from self._end(Status.RUNNING)
+            return
+        yield from self.decorated.tick()
+        s = self.decorated.status
+        if s in _DONE:
+            _reset(self.decorated)
+            self.until = None
+        yield from self._end(s)
+
+
 class Unresolved(py_trees.behaviour.Behaviour):
     """A subtree call btc could not expand: FAILURE."""
 
@@ -926,6 +961,8 @@ def _decorator_name(kind, arg):
         return "Repeat(%d)" % arg
     if kind == "timeout":
         return "Timeout(%d ms)" % arg
+    if kind == "delay":
+        return "Delay(%d ms)" % arg
     return {
         "inverter": "Inverter",
         "force_success": "ForceSuccess",
@@ -996,6 +1033,8 @@ class _Builder:
                 return Repeat(name, c, arg)
             if dkind == "timeout":
                 return Timeout(name, c, arg)
+            if dkind == "delay":
+                return Delay(name, c, arg)
             if dkind == "inverter":
                 return py_trees.decorators.Inverter(name=name, child=c)
             if dkind == "force_success":

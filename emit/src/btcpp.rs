@@ -7,7 +7,6 @@
 //! `SubTree` elements get no `name` attribute: Groot2's monitor crashes on it.
 
 use btc_ir::*;
-use btc_ir::{ControlKind, DecoratorKind};
 use std::fmt::Write as _;
 
 /// Whether a character must be escaped (or replaced) in an attribute value.
@@ -190,27 +189,6 @@ impl Xml {
     }
 }
 
-fn control_tag(c: ControlKind) -> &'static str {
-    match c {
-        ControlKind::Sequence => "Sequence",
-        ControlKind::ReactiveSequence => "ReactiveSequence",
-        ControlKind::Fallback => "Fallback",
-        ControlKind::ReactiveFallback => "ReactiveFallback",
-        ControlKind::Parallel { .. } => "Parallel",
-    }
-}
-
-fn decorator_tag(d: &DecoratorKind) -> &'static str {
-    match d {
-        DecoratorKind::Retry { .. } => "RetryUntilSuccessful",
-        DecoratorKind::Repeat { .. } => "Repeat",
-        DecoratorKind::Timeout { .. } => "Timeout",
-        DecoratorKind::Inverter => "Inverter",
-        DecoratorKind::ForceSuccess => "ForceSuccess",
-        DecoratorKind::ForceFailure => "ForceFailure",
-    }
-}
-
 fn number(x: &mut Xml, key: &str, n: impl std::fmt::Display) {
     x.attr_with(key, |out| {
         let _ = write!(out, "{n}");
@@ -224,11 +202,11 @@ fn node(x: &mut Xml, n: &Node, ir: &TreeIr) {
             name,
             children,
         } => {
-            let tag = control_tag(*control);
+            let spec = control.spec();
+            let tag = spec.tag;
             x.open(tag).name(name);
-            if let ControlKind::Parallel { success, failure } = control {
-                number(x, "success_count", success);
-                number(x, "failure_count", failure);
+            for (p, v) in spec.params.iter().zip(control.params()) {
+                number(x, p.port, v);
             }
             x.close(children.is_empty());
             if children.is_empty() {
@@ -244,13 +222,11 @@ fn node(x: &mut Xml, n: &Node, ir: &TreeIr) {
             name,
             child,
         } => {
-            let tag = decorator_tag(decorator);
+            let spec = decorator.spec();
+            let tag = spec.tag;
             x.open(tag).name(name);
-            match decorator {
-                DecoratorKind::Retry { times } => number(x, "num_attempts", times),
-                DecoratorKind::Repeat { times } => number(x, "num_cycles", times),
-                DecoratorKind::Timeout { ms } => number(x, "msec", ms),
-                _ => {}
+            if let (Some(p), Some(count)) = (spec.params.first(), decorator.count()) {
+                number(x, p.port, count);
             }
             x.close(false);
             node(x, child, ir);

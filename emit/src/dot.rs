@@ -5,27 +5,19 @@
 use btc_ir::*;
 use btc_ir::{ControlKind, DecoratorKind};
 
+/// The vocabulary's label with the node's parameters filled in.
 fn control_label(c: ControlKind) -> String {
-    match c {
-        ControlKind::Sequence => "→".into(),
-        ControlKind::ReactiveSequence => "→ (reactive)".into(),
-        ControlKind::Fallback => "?".into(),
-        ControlKind::ReactiveFallback => "? (reactive)".into(),
-        ControlKind::Parallel { success, failure } => {
-            format!("⇒ (success {success}, failure {failure})")
-        }
-    }
+    let values = c.params();
+    let params = c.spec().params;
+    c.spec().label_with(|p| {
+        let i = params.iter().position(|q| q == p).unwrap_or(0);
+        values.get(i).map_or_else(String::new, u32::to_string)
+    })
 }
 
 fn decorator_label(d: &DecoratorKind) -> String {
-    match d {
-        DecoratorKind::Retry { times } => format!("retry {times}"),
-        DecoratorKind::Repeat { times } => format!("repeat {times}"),
-        DecoratorKind::Timeout { ms } => format!("timeout {ms} ms"),
-        DecoratorKind::Inverter => "invert".into(),
-        DecoratorKind::ForceSuccess => "force success".into(),
-        DecoratorKind::ForceFailure => "force failure".into(),
-    }
+    d.spec()
+        .label_with(|_| d.count().map_or_else(String::new, Count::to_string))
 }
 
 fn leaf_label(id: &str, name: &Option<Label>, ports: &[Port]) -> String {

@@ -17,8 +17,10 @@ use std::collections::HashSet;
 pub mod json;
 mod label;
 mod nodes;
+pub mod vocab;
 pub use label::{Label, LabelPart};
 pub use nodes::{ControlKind, Count, DecoratorKind};
+pub use vocab::{ControlName, DecoratorName, NodeSpec};
 
 /// The version of the IR's JSON encoding (`"ir_version"`). Version 1 (PDDL
 /// as strings, no world) is still read: [`json::decode`].
@@ -273,7 +275,7 @@ impl TreeIr {
         self.trees = trees;
     }
 
-    /// The trees whose `Timeout` takes its duration from a port, and the
+    /// The trees whose `Timeout` (or other duration) takes it from a port, and the
     /// trees that call them. BehaviorTree.CPP 4.10 stores a number passed
     /// to a `<SubTree>` port as an `int` entry while `Timeout`'s `msec`
     /// port is `unsigned`, so such a tree would not load there: lowering
@@ -285,12 +287,14 @@ impl TreeIr {
                 Node::Decorator {
                     decorator, child, ..
                 } => {
-                    matches!(
-                        decorator,
-                        DecoratorKind::Timeout {
-                            ms: Count::Param { .. }
-                        }
-                    ) || uses(child, set)
+                    // BT.CPP's durations (`Timeout`, `Delay`) are unsigned.
+                    let unsigned = decorator
+                        .spec()
+                        .params
+                        .first()
+                        .is_some_and(|p| p.ty == vocab::ParamType::Millis);
+                    (unsigned && matches!(decorator.count(), Some(Count::Param { .. })))
+                        || uses(child, set)
                 }
                 Node::Control { children, .. } => children.iter().any(|c| uses(c, set)),
                 Node::Step { child, .. } => uses(child, set),

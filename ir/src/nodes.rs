@@ -1,5 +1,6 @@
 //! The control and decorator nodes a tree is built of.
 
+use crate::vocab::{ControlName, DecoratorName, NodeSpec};
 use serde::{Deserialize, Serialize};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -13,14 +14,46 @@ pub enum ControlKind {
 }
 
 impl ControlKind {
-    pub fn keyword(self) -> &'static str {
+    pub fn name(self) -> ControlName {
         match self {
-            ControlKind::Sequence => "sequence",
-            ControlKind::ReactiveSequence => "reactive_sequence",
-            ControlKind::Fallback => "fallback",
-            ControlKind::ReactiveFallback => "reactive_fallback",
-            ControlKind::Parallel { .. } => "parallel",
+            ControlKind::Sequence => ControlName::Sequence,
+            ControlKind::ReactiveSequence => ControlName::ReactiveSequence,
+            ControlKind::Fallback => ControlName::Fallback,
+            ControlKind::ReactiveFallback => ControlName::ReactiveFallback,
+            ControlKind::Parallel { .. } => ControlName::Parallel,
         }
+    }
+
+    /// The control `name` with its parameters' values in the order the
+    /// vocabulary lists them (`parallel`: success, failure).
+    pub fn new(name: ControlName, params: &[u32]) -> ControlKind {
+        let p = |i: usize| params.get(i).copied().unwrap_or(0);
+        match name {
+            ControlName::Sequence => ControlKind::Sequence,
+            ControlName::ReactiveSequence => ControlKind::ReactiveSequence,
+            ControlName::Fallback => ControlKind::Fallback,
+            ControlName::ReactiveFallback => ControlKind::ReactiveFallback,
+            ControlName::Parallel => ControlKind::Parallel {
+                success: p(0),
+                failure: p(1),
+            },
+        }
+    }
+
+    /// The parameters' values, in the vocabulary's order.
+    pub fn params(self) -> Vec<u32> {
+        match self {
+            ControlKind::Parallel { success, failure } => vec![success, failure],
+            _ => Vec::new(),
+        }
+    }
+
+    pub fn spec(self) -> &'static NodeSpec {
+        self.name().spec()
+    }
+
+    pub fn keyword(self) -> &'static str {
+        self.spec().keyword
     }
 }
 
@@ -33,6 +66,8 @@ pub enum DecoratorKind {
     Inverter,
     ForceSuccess,
     ForceFailure,
+    Delay { ms: Count },
+    RunOnce,
 }
 
 /// A decorator's count or duration: a number, or (in a rule's tree, when
@@ -67,33 +102,52 @@ impl std::fmt::Display for Count {
 }
 
 impl DecoratorKind {
-    pub fn keyword(&self) -> &'static str {
+    pub fn name(&self) -> DecoratorName {
         match self {
-            DecoratorKind::Retry { .. } => "retry",
-            DecoratorKind::Repeat { .. } => "repeat",
-            DecoratorKind::Timeout { .. } => "timeout",
-            DecoratorKind::Inverter => "inverter",
-            DecoratorKind::ForceSuccess => "force_success",
-            DecoratorKind::ForceFailure => "force_failure",
+            DecoratorKind::Retry { .. } => DecoratorName::Retry,
+            DecoratorKind::Repeat { .. } => DecoratorName::Repeat,
+            DecoratorKind::Timeout { .. } => DecoratorName::Timeout,
+            DecoratorKind::Inverter => DecoratorName::Inverter,
+            DecoratorKind::ForceSuccess => DecoratorName::ForceSuccess,
+            DecoratorKind::ForceFailure => DecoratorName::ForceFailure,
+            DecoratorKind::Delay { .. } => DecoratorName::Delay,
+            DecoratorKind::RunOnce => DecoratorName::RunOnce,
         }
+    }
+
+    /// The decorator `name` with its count (ignored by those without one).
+    pub fn new(name: DecoratorName, count: Count) -> DecoratorKind {
+        match name {
+            DecoratorName::Retry => DecoratorKind::Retry { times: count },
+            DecoratorName::Repeat => DecoratorKind::Repeat { times: count },
+            DecoratorName::Timeout => DecoratorKind::Timeout { ms: count },
+            DecoratorName::Inverter => DecoratorKind::Inverter,
+            DecoratorName::ForceSuccess => DecoratorKind::ForceSuccess,
+            DecoratorName::ForceFailure => DecoratorKind::ForceFailure,
+            DecoratorName::Delay => DecoratorKind::Delay { ms: count },
+            DecoratorName::RunOnce => DecoratorKind::RunOnce,
+        }
+    }
+
+    pub fn spec(&self) -> &'static NodeSpec {
+        self.name().spec()
+    }
+
+    pub fn keyword(&self) -> &'static str {
+        self.spec().keyword
     }
 
     /// The count or duration, for the decorators that have one.
     pub fn count(&self) -> Option<&Count> {
         match self {
             DecoratorKind::Retry { times } | DecoratorKind::Repeat { times } => Some(times),
-            DecoratorKind::Timeout { ms } => Some(ms),
+            DecoratorKind::Timeout { ms } | DecoratorKind::Delay { ms } => Some(ms),
             _ => None,
         }
     }
 
     /// The same decorator with its count replaced.
     pub fn with_count(&self, count: Count) -> DecoratorKind {
-        match self {
-            DecoratorKind::Retry { .. } => DecoratorKind::Retry { times: count },
-            DecoratorKind::Repeat { .. } => DecoratorKind::Repeat { times: count },
-            DecoratorKind::Timeout { .. } => DecoratorKind::Timeout { ms: count },
-            other => other.clone(),
-        }
+        DecoratorKind::new(self.name(), count)
     }
 }

@@ -374,20 +374,11 @@ impl Inst<'_> {
             }
             Count::Param { param: p }
         };
-        match d {
-            DecoratorName::Retry => DecoratorKind::Retry {
-                times: count(self, "times"),
-            },
-            DecoratorName::Repeat => DecoratorKind::Repeat {
-                times: count(self, "times"),
-            },
-            DecoratorName::Timeout => DecoratorKind::Timeout {
-                ms: count(self, "msec"),
-            },
-            DecoratorName::Inverter => DecoratorKind::Inverter,
-            DecoratorName::ForceSuccess => DecoratorKind::ForceSuccess,
-            DecoratorName::ForceFailure => DecoratorKind::ForceFailure,
-        }
+        let count = match d.param() {
+            Some(p) => count(self, p.name),
+            None => Count::Fixed(0),
+        };
+        DecoratorKind::new(d, count)
     }
 
     fn templates(&mut self, ts: &[Template], steps: &dyn Fn(StepsMode) -> Vec<Node>) -> Vec<Node> {

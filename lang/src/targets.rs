@@ -7,6 +7,7 @@ use crate::db::{self, CompileJob, Db};
 use crate::rules::ast::{Item, RuleBody, Template};
 use crate::rules::name::Key;
 use crate::rules::parse::shift;
+use btc_ir::vocab::{DecoratorName, PyTrees};
 use btc_ir::{Node, TreeIr};
 use btc_pddl::diagnostic::{codes, Diagnostic};
 use btc_pddl::source::Span;
@@ -55,7 +56,8 @@ pub fn refusals(db: &dyn Db, job: CompileJob, ir: &TreeIr, target: Target) -> Ve
         .iter()
         .filter(|u| uses_leaf(ir, u.id))
         .collect();
-    if used.is_empty() {
+    let nodes = nodes_not_in_pytrees(ir);
+    if used.is_empty() && nodes.is_empty() {
         return Vec::new();
     }
     let mut out = Vec::new();
@@ -69,6 +71,26 @@ pub fn refusals(db: &dyn Db, job: CompileJob, ir: &TreeIr, target: Target) -> Ve
             let mut found = Vec::new();
             for t in templates(&node.item) {
                 calls(t, &mut found);
+            }
+            let mut decorators = Vec::new();
+            for t in templates(&node.item) {
+                decorators_in(t, &mut decorators);
+            }
+            for (d, span) in decorators {
+                if let (true, PyTrees::NotExpressible { why }) =
+                    (nodes.contains(&d), d.spec().pytrees)
+                {
+                    let d = Diagnostic::error(
+                        codes::E_PYTREES_NODE,
+                        span,
+                        format!(
+                            "a py_trees module cannot run `{}`, which {why}",
+                            d.keyword()
+                        ),
+                    )
+                    .with_hint("emit BT.CPP XML (`--emit btcpp`) or run it with `btc run`");
+                    out.push(shift(d, id, node.offset));
+                }
             }
             for (name, span) in found {
                 let Some(u) = used.iter().find(|u| name == Key::new(u.id)) else {
@@ -86,6 +108,53 @@ pub fn refusals(db: &dyn Db, job: CompileJob, ir: &TreeIr, target: Target) -> Ve
     }
     out.sort_by_key(|d| (d.span.file, d.span.start));
     out
+}
+
+/// The decorators in the compiled tree that the vocabulary marks as not
+/// expressible in py_trees.
+fn nodes_not_in_pytrees(ir: &TreeIr) -> Vec<DecoratorName> {
+    let mut found = Vec::new();
+    let mut look = |n: &Node| {
+        if let Node::Decorator { decorator, .. } = n {
+            let name = decorator.name();
+            if matches!(name.spec().pytrees, PyTrees::NotExpressible { .. })
+                && !found.contains(&name)
+            {
+                found.push(name);
+            }
+        }
+    };
+    ir.root.walk(&mut look);
+    for t in &ir.trees {
+        t.root.walk(&mut look);
+    }
+    found
+}
+
+/// Every decorator in a template, with the span of its keyword.
+fn decorators_in(t: &Template, out: &mut Vec<(DecoratorName, Span)>) {
+    match t {
+        Template::Control { children, .. } => {
+            children.iter().for_each(|c| decorators_in(c, out));
+        }
+        Template::Decorator {
+            decorator,
+            child,
+            span,
+            ..
+        } => {
+            let word = decorator.keyword().len() as u32;
+            out.push((
+                *decorator,
+                Span {
+                    end: span.start + word,
+                    ..*span
+                },
+            ));
+            decorators_in(child, out);
+        }
+        Template::Call { .. } | Template::Steps { .. } | Template::Error { .. } => {}
+    }
 }
 
 /// Whether a leaf `id` is in the compiled tree (the main tree or a rule's).

@@ -2,7 +2,7 @@
 //! the cursor, so it works while the item being typed does not parse.
 
 use crate::analysis::Analysis;
-use crate::syntax::{ITEM_KEYWORDS, TEMPLATE_KEYWORDS};
+use crate::syntax::{template_keywords, ITEM_KEYWORDS};
 use btc_lang::db::STDLIB;
 use btc_lang::rules::ast::{Item, NodeKind, PortDecl};
 use btc_lang::rules::lexer::Tok;
@@ -334,8 +334,8 @@ pub fn completion(a: &Analysis, offset: usize) -> Vec<CompletionItem> {
             for (name, t) in &a.decls.trees {
                 out.push(call_item(name, &t.ports, CompletionItemKind::CLASS));
             }
-            for k in TEMPLATE_KEYWORDS {
-                out.push(item(*k, CompletionItemKind::KEYWORD, None));
+            for k in template_keywords() {
+                out.push(item(k, CompletionItemKind::KEYWORD, None));
             }
         }
         Context::TopLevel => {

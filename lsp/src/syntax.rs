@@ -12,20 +12,8 @@ pub const DECL_KEYWORDS: &[&str] = &["action", "condition", "tree", "table"];
 
 pub use btc_lang::rules::parse::ITEM_KEYWORDS;
 
-pub const TEMPLATE_KEYWORDS: &[&str] = &[
-    "sequence",
-    "reactive_sequence",
-    "fallback",
-    "reactive_fallback",
-    "parallel",
-    "retry",
-    "repeat",
-    "timeout",
-    "inverter",
-    "force_success",
-    "force_failure",
-    "steps",
-];
+/// Node keywords (from the node vocabulary) and `steps`.
+pub use btc_lang::rules::parse::template_keywords;
 
 pub const OTHER_KEYWORDS: &[&str] = &[
     "effect",
@@ -159,7 +147,7 @@ impl<'a> Tokens<'a> {
 /// Whether a word is one of the language's keywords.
 pub fn is_keyword(word: &str) -> bool {
     ITEM_KEYWORDS.contains(&word)
-        || TEMPLATE_KEYWORDS.contains(&word)
+        || template_keywords().any(|k| k == word)
         || OTHER_KEYWORDS.contains(&word)
 }
 

@@ -35,7 +35,7 @@ pub enum Kind {
         cases: Vec<PortValue>,
     },
     /// `Delay`: the child is ticked once `msec` (simulated) have passed.
-    Delay(u64),
+    Delay(Amount<u64>),
     /// `RunOnce`: the child runs to completion once; after that the node
     /// is SKIPPED (`then_skip`) or returns what the child returned.
     RunOnce {
@@ -298,6 +298,8 @@ pub fn from_node(n: &Node) -> SNode {
                 DecoratorKind::Inverter => Kind::Inverter,
                 DecoratorKind::ForceSuccess => Kind::ForceSuccess,
                 DecoratorKind::ForceFailure => Kind::ForceFailure,
+                DecoratorKind::Delay { ms } => Kind::Delay(amount(ms, |n| n)),
+                DecoratorKind::RunOnce => Kind::RunOnce { then_skip: true },
             },
             name.as_ref().map(ToString::to_string),
             vec![from_node(child)],

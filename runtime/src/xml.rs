@@ -292,16 +292,19 @@ fn node_of(mut e: Elem) -> Result<SNode, LoadError> {
                 .collect();
             Kind::Switch { variable, cases }
         }
-        "Delay" => {
-            let ms = e.int("delay_msec", None)?;
-            Kind::Delay(u64::try_from(ms).map_err(|_| {
-                LoadError::new(
-                    codes::X_BAD_PORT,
-                    "<Delay>: `delay_msec` must not be negative",
-                )
-                .at(e.at)
-            })?)
-        }
+        "Delay" => Kind::Delay(match e.entry("delay_msec") {
+            Some(k) => Amount::Entry(k),
+            None => {
+                let ms = e.int("delay_msec", None)?;
+                Amount::Fixed(u64::try_from(ms).map_err(|_| {
+                    LoadError::new(
+                        codes::X_BAD_PORT,
+                        "<Delay>: `delay_msec` must not be negative",
+                    )
+                    .at(e.at)
+                })?)
+            }
+        }),
         "RunOnce" => Kind::RunOnce {
             then_skip: match e.get("then_skip").map(str::trim) {
                 None | Some("true") | Some("1") => true,

@@ -17,7 +17,8 @@
 mod encode;
 pub mod names;
 
-use btc_ir::{ControlKind, Count, DecoratorKind};
+use btc_ir::vocab::{NodeSpec, PyTrees};
+use btc_ir::Count;
 use btc_ir::{Label, LeafKind, Node, NodeModel, Port, StepInfo, TreeIr};
 use btc_pddl::logic::InitFact;
 use names::{is_plain_kwarg, RESERVED};
@@ -408,16 +409,10 @@ impl<'a> Emitter<'a> {
                 name,
                 children,
             } => {
-                let tag = match control {
-                    ControlKind::Sequence => "Q",
-                    ControlKind::ReactiveSequence => "q",
-                    ControlKind::Fallback => "F",
-                    ControlKind::ReactiveFallback => "f",
-                    ControlKind::Parallel { .. } => "P",
-                };
+                let tag = pytrees_code(control.spec());
                 let _ = write!(o, "(\"{tag}\", {}, ", opt_name(name));
-                if let ControlKind::Parallel { success, failure } = control {
-                    let _ = write!(o, "{success}, {failure}, ");
+                for v in control.params() {
+                    let _ = write!(o, "{v}, ");
                 }
                 o.push_str("(\n");
                 for c in children {
@@ -433,14 +428,8 @@ impl<'a> Emitter<'a> {
                 name,
                 child,
             } => {
-                let (kind, count) = match decorator {
-                    DecoratorKind::Retry { times } => ("retry", Some(times)),
-                    DecoratorKind::Repeat { times } => ("repeat", Some(times)),
-                    DecoratorKind::Timeout { ms } => ("timeout", Some(ms)),
-                    DecoratorKind::Inverter => ("inverter", None),
-                    DecoratorKind::ForceSuccess => ("force_success", None),
-                    DecoratorKind::ForceFailure => ("force_failure", None),
-                };
+                let kind = pytrees_code(decorator.spec());
+                let count = decorator.count();
                 // A count from the call is a parameter, filled in when the
                 // tree is built.
                 let arg = match count {
@@ -661,3 +650,12 @@ fn class_def(o: &mut String, name: &str, m: &NodeModel) {
 
 #[cfg(test)]
 mod tests;
+
+/// The tuple code of a node the py_trees target can express; the target
+/// refuses rules with the others before anything is emitted (E001).
+fn pytrees_code(spec: &NodeSpec) -> &'static str {
+    match spec.pytrees {
+        PyTrees::Built { code, .. } => code,
+        PyTrees::NotExpressible { .. } => spec.keyword,
+    }
+}

@@ -81,6 +81,7 @@ pub(crate) const RESERVED: &[&str] = &[
     "AlwaysFailure",
     "AlwaysSuccess",
     "Condition",
+    "Delay",
     "KB_KEY",
     "KbApply",
     "KbBehaviour",

@@ -356,86 +356,9 @@ impl Value {
     }
 }
 
-/// The decorators of the language, by keyword.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum DecoratorName {
-    Retry,
-    Repeat,
-    Timeout,
-    Inverter,
-    ForceSuccess,
-    ForceFailure,
-}
-
-/// A decorator's parameter: its name (as BT.CPP's port is called, or
-/// shorter) and the whole numbers it takes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct DecoratorParam {
-    pub name: &'static str,
-    /// What the number counts, for messages.
-    pub what: &'static str,
-    pub min: i64,
-    pub max: i64,
-}
-
-impl DecoratorName {
-    pub const ALL: &'static [DecoratorName] = &[
-        DecoratorName::Retry,
-        DecoratorName::Repeat,
-        DecoratorName::Timeout,
-        DecoratorName::Inverter,
-        DecoratorName::ForceSuccess,
-        DecoratorName::ForceFailure,
-    ];
-
-    pub fn keyword(self) -> &'static str {
-        match self {
-            DecoratorName::Retry => "retry",
-            DecoratorName::Repeat => "repeat",
-            DecoratorName::Timeout => "timeout",
-            DecoratorName::Inverter => "inverter",
-            DecoratorName::ForceSuccess => "force_success",
-            DecoratorName::ForceFailure => "force_failure",
-        }
-    }
-
-    pub fn from_keyword(word: &str) -> Option<DecoratorName> {
-        DecoratorName::ALL
-            .iter()
-            .copied()
-            .find(|d| d.keyword() == word)
-    }
-
-    /// The one parameter of `retry`, `repeat` and `timeout`. BT.CPP reads
-    /// the counts as `int` and the duration as `unsigned`; 0 would never
-    /// run the child.
-    pub fn param(self) -> Option<DecoratorParam> {
-        match self {
-            DecoratorName::Retry => Some(DecoratorParam {
-                name: "times",
-                what: "attempts",
-                min: 1,
-                max: i32::MAX as i64,
-            }),
-            DecoratorName::Repeat => Some(DecoratorParam {
-                name: "times",
-                what: "repetitions",
-                min: 1,
-                max: i32::MAX as i64,
-            }),
-            DecoratorName::Timeout => Some(DecoratorParam {
-                name: "msec",
-                what: "milliseconds",
-                min: 1,
-                max: u32::MAX as i64,
-            }),
-            DecoratorName::Inverter | DecoratorName::ForceSuccess | DecoratorName::ForceFailure => {
-                None
-            }
-        }
-    }
-}
+/// The decorators of the language and their parameters: the node
+/// vocabulary's.
+pub use btc_ir::vocab::{DecoratorName, Param as DecoratorParam};
 
 /// A decorator's argument, by position (`retry(3)`) or by its parameter's
 /// name (`timeout(msec: ?t)`). It takes the values a port takes.

@@ -275,13 +275,19 @@ impl Formatter<'_> {
     }
 }
 
+/// `sequence`, `parallel(success: 2, failure: 1)`: every parameter by name.
 fn control_head(c: ControlKind) -> String {
-    match c {
-        ControlKind::Parallel { success, failure } => {
-            format!("parallel(success: {success}, failure: {failure})")
-        }
-        other => other.keyword().to_owned(),
+    let spec = c.spec();
+    if spec.params.is_empty() {
+        return spec.keyword.to_owned();
     }
+    let a: Vec<String> = spec
+        .params
+        .iter()
+        .zip(c.params())
+        .map(|(p, v)| format!("{}: {v}", p.name))
+        .collect();
+    format!("{}({})", spec.keyword, a.join(", "))
 }
 
 /// `retry(3)`, `timeout(msec: ?t)`: arguments as written.

@@ -5,6 +5,7 @@
 
 use super::ast::*;
 use super::lexer::{lex, Comment, Tok};
+use btc_ir::vocab::{Arity, ControlName, NodeSpec};
 use btc_pddl::diagnostic::{codes, Diagnostic};
 use btc_pddl::lexer::{Tok as PTok, Token as PToken};
 use btc_pddl::parse::{effect_of, formula_of};
@@ -22,16 +23,10 @@ use std::rc::Rc;
 /// every pass after it recurse through.
 pub const MAX_ITEM_DEPTH: usize = 64;
 
-/// Words that make a decorator of the template after them.
-const DECORATORS: &[&str] = &["inverter", "force_success", "force_failure"];
-const DECORATORS_WITH_ARGUMENT: &[&str] = &["retry", "repeat", "timeout"];
-const CONTROLS: &[&str] = &[
-    "sequence",
-    "reactive_sequence",
-    "fallback",
-    "reactive_fallback",
-    "parallel",
-];
+/// The vocabulary's entry for a node keyword.
+fn node_spec(word: &str) -> Option<&'static NodeSpec> {
+    NodeSpec::by_keyword(word)
+}
 
 /// How deep an item nests as the parser will recurse: each bracket is a
 /// level, and so is each decorator of a chain, until the template the
@@ -71,13 +66,18 @@ impl Nesting {
             }
             Tok::Ident(w) if in_block => {
                 let next = tokens.get(i + 1).map(|t| &t.0);
-                let bare = DECORATORS.contains(&w.as_str())
-                    && matches!(next, Some(Tok::Ident(_) | Tok::Str(_)));
-                let with_arg = DECORATORS_WITH_ARGUMENT.contains(&w.as_str())
-                    && matches!(next, Some(Tok::Punct("(")));
-                if bare || with_arg {
+                let spec = node_spec(w);
+                // Words that make a decorator of the template after them.
+                let decorator = spec.filter(|s| s.arity == Arity::One).map(|s| {
+                    if s.params.is_empty() {
+                        matches!(next, Some(Tok::Ident(_) | Tok::Str(_)))
+                    } else {
+                        matches!(next, Some(Tok::Punct("(")))
+                    }
+                });
+                if decorator == Some(true) {
                     self.chain += 1;
-                } else if CONTROLS.contains(&w.as_str()) {
+                } else if spec.is_some_and(|s| s.arity != Arity::One) {
                     // Its block (after `parallel(...)`'s arguments) nests
                     // inside the chain.
                 } else if matches!(next, Some(Tok::Punct("("))) || matches!(w.as_str(), "steps") {
@@ -92,6 +92,15 @@ impl Nesting {
         }
         self.base + self.chain
     }
+}
+
+/// Words that start a template: the vocabulary's node keywords, and
+/// `steps`.
+pub fn template_keywords() -> impl Iterator<Item = &'static str> {
+    btc_ir::vocab::NODES
+        .iter()
+        .map(|s| s.keyword)
+        .chain(["steps"])
 }
 
 /// Words that start a top-level item.
@@ -691,23 +700,38 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
 
     let template = recursive(|template| {
         let block = block_of(template.clone(), file);
-        let parallel_args = kw("success")
-            .ignore_then(punct(":"))
-            .ignore_then(count)
-            .then_ignore(punct(","))
-            .then_ignore(kw("failure"))
+        // A control keyword of the vocabulary, and its parameters by name
+        // (`parallel(success: 2, failure: 1)`), all of them, in its order.
+        let control_name = select! {
+            Tok::Ident(s) if ControlName::from_keyword(&s).is_some() => s,
+        }
+        .map(|s| ControlName::from_keyword(&s).expect("selected"));
+        let control_args = select! { Tok::Ident(s) => s }
             .then_ignore(punct(":"))
             .then(count)
+            .separated_by(punct(","))
+            .collect::<Vec<_>>()
             .delimited_by(punct("("), punct(")"));
-        let control_kind = choice((
-            kw("sequence").to(ControlKind::Sequence),
-            kw("reactive_sequence").to(ControlKind::ReactiveSequence),
-            kw("fallback").to(ControlKind::Fallback),
-            kw("reactive_fallback").to(ControlKind::ReactiveFallback),
-            kw("parallel")
-                .ignore_then(parallel_args)
-                .map(|(success, failure)| ControlKind::Parallel { success, failure }),
-        ));
+        let control_kind = control_name.then(control_args.or_not()).try_map(
+            |(name, args): (ControlName, Option<Vec<(String, u32)>>), span| {
+                let spec = name.spec();
+                let given = args.unwrap_or_default();
+                let names = given.iter().map(|(n, _)| n.as_str());
+                if names.ne(spec.params.iter().map(|p| p.name)) {
+                    let shape: Vec<String> = spec
+                        .params
+                        .iter()
+                        .map(|p| format!("{}: N", p.name))
+                        .collect();
+                    return Err(Rich::custom(
+                        span,
+                        format!("expected `{}({})`", spec.keyword, shape.join(", ")),
+                    ));
+                }
+                let values: Vec<u32> = given.into_iter().map(|(_, v)| v).collect();
+                Ok(ControlKind::new(name, &values))
+            },
+        );
         let control = control_kind.then(strlit.or_not()).then(block).map_with(
             move |((control, name), children), e| Template::Control {
                 control,

@@ -323,7 +323,7 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
                     cases: cases.len() as u32,
                 }
             }
-            Kind::Delay(ms) => Op::Delay(*ms),
+            Kind::Delay(ms) => Op::Delay(self.arg(ms, scope)),
             Kind::RunOnce { then_skip } => Op::RunOnce {
                 then_skip: *then_skip,
             },

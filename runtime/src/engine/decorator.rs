@@ -132,7 +132,7 @@ impl<'w> Engine<'w> {
 
     /// A decorator's count: fixed, or read from its blackboard slot (a fault
     /// reason when the entry holds no number the decorator takes).
-    fn amount<T: Copy>(
+    pub(super) fn amount<T: Copy>(
         &self,
         a: Arg<T>,
         port: &str,

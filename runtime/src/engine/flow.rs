@@ -3,7 +3,7 @@
 
 use super::record::Reason;
 use super::state::NodeState;
-use super::{Engine, NodeDef, Status, Value};
+use super::{Arg, Engine, NodeDef, Status, Value};
 
 impl<'w> Engine<'w> {
     /// The condition (first child) picks the then (second) or the else
@@ -114,10 +114,19 @@ impl<'w> Engine<'w> {
     }
 
     /// RUNNING for `msec` of simulated time, then the child's status.
-    pub(super) fn tick_delay(&mut self, iu: usize, def: NodeDef, msec: u64) -> Status {
+    pub(super) fn tick_delay(&mut self, i: u32, def: NodeDef, arg: Arg<u64>) -> Status {
+        let iu = i as usize;
         let until = match self.state[iu] {
             NodeState::Until(t) => t,
             _ => {
+                // Read when the delay starts, as BT.CPP does.
+                let msec = match self.amount(arg, "delay_msec", |n| u64::try_from(n).ok()) {
+                    Ok(ms) => ms,
+                    Err(r) => {
+                        self.note_failure(i, r);
+                        return Status::Failure;
+                    }
+                };
                 self.set(iu, Status::Running);
                 let t = self.now_ms.saturating_add(msec);
                 self.state[iu] = NodeState::Until(t);

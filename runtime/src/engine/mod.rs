@@ -99,7 +99,7 @@ pub(crate) enum Op {
         first_case: u32,
         cases: u32,
     },
-    Delay(u64),
+    Delay(Arg<u64>),
     RunOnce {
         then_skip: bool,
     },
@@ -490,7 +490,7 @@ impl<'w> Engine<'w> {
                 first_case,
                 cases,
             } => self.tick_switch(iu, def, variable, first_case, cases),
-            Op::Delay(msec) => self.tick_delay(iu, def, msec),
+            Op::Delay(msec) => self.tick_delay(i, def, msec),
             Op::RunOnce { then_skip } => self.tick_run_once(iu, def, then_skip),
             Op::Precondition { script, otherwise } => {
                 self.tick_precondition(i, def, script, otherwise)
