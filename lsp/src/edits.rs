@@ -5,6 +5,7 @@ use crate::analysis::Analysis;
 use crate::convert::LineIndex;
 use btc_lang::db::{import_closure, parsed_rules, rules_diagnostics};
 use btc_lang::rules::ast::Item;
+use btc_lang::rules::fmt::format_parsed;
 use btc_lang::rules::matching::match_name;
 use btc_lang::rules::name::camel_case;
 use btc_pddl::ast::{Action, TypeSpec};
@@ -17,7 +18,7 @@ use tower_lsp::lsp_types::{
 /// The whole document formatted, as one edit; `None` when the text does
 /// not parse (the formatter refuses it) or is formatted already.
 pub fn format(a: &Analysis) -> Option<Vec<TextEdit>> {
-    let formatted = btc_lang::rules::fmt::format(a.text).ok()?;
+    let formatted = format_parsed(a.text, parsed_rules(&a.ws.db, a.file)).ok()?;
     if formatted == a.text {
         return Some(Vec::new());
     }

@@ -5,7 +5,7 @@
 
 use super::ast::*;
 use super::lexer::Comment;
-use super::parse::parse_rules;
+use super::parse::{parse_rules, ParsedRules};
 use btc_ir::format_float;
 use btc_pddl::diagnostic::Diagnostic;
 
@@ -14,13 +14,18 @@ const INDENT: &str = "    ";
 const ONE_LINE: usize = 100;
 
 pub fn format(text: &str) -> Result<String, Vec<Diagnostic>> {
-    let parsed = parse_rules(text, 0);
+    format_parsed(text, &parse_rules(text, 0))
+}
+
+/// [`format`] of a text parsed already (the language server's database
+/// holds it parsed: parsing it again cost most of a formatting request).
+pub fn format_parsed(text: &str, parsed: &ParsedRules) -> Result<String, Vec<Diagnostic>> {
     if !parsed.diagnostics.is_empty() {
-        return Err(parsed.diagnostics);
+        return Err(parsed.diagnostics.clone());
     }
     let mut f = Formatter {
         text,
-        comments: parsed.comments,
+        comments: &parsed.comments,
         next_comment: 0,
         lines: Vec::new(),
         offset: 0,
@@ -61,7 +66,7 @@ pub fn format(text: &str) -> Result<String, Vec<Diagnostic>> {
 
 struct Formatter<'a> {
     text: &'a str,
-    comments: Vec<Comment>,
+    comments: &'a [Comment],
     next_comment: usize,
     lines: Vec<String>,
     /// Offset of the item being printed (its spans are relative to it).
@@ -71,15 +76,16 @@ struct Formatter<'a> {
 impl Formatter<'_> {
     /// Emits the comments that start before `pos` (absolute).
     fn flush(&mut self, pos: usize, depth: usize) {
-        while let Some(c) = self.comments.get(self.next_comment) {
+        let comments = self.comments;
+        while let Some(c) = comments.get(self.next_comment) {
             if c.span.start as usize >= pos {
                 break;
             }
-            let text = c.text.clone();
+            let text = &c.text;
             match (c.trailing, self.lines.last_mut()) {
                 (true, Some(last)) if !last.is_empty() => {
                     last.push_str("  ");
-                    last.push_str(&text);
+                    last.push_str(text);
                 }
                 _ => {
                     for (i, l) in text.lines().enumerate() {

@@ -11,8 +11,12 @@ use btc_pddl::lexer::{Tok as PTok, Token as PToken};
 use btc_pddl::parse::{effect_of, formula_of};
 use btc_pddl::sexpr;
 use btc_pddl::source::{FileId, Span};
-use chumsky::input::ValueInput;
+use chumsky::cache::{Cache, Cached};
+use chumsky::input::{MappedInput, ValueInput};
 use chumsky::prelude::*;
+use std::cell::RefCell;
+use std::collections::HashMap;
+use std::rc::Rc;
 
 /// Deepest nesting inside one item: brackets, and decorators chained on one
 /// template (`inverter retry(3) X()` is three levels), which the parser and
@@ -478,8 +482,10 @@ fn parse_item(
         i += 1;
     }
     let eoi = SimpleSpan::from(whole.end as usize..whole.end as usize);
-    let (item, errors) = item_parser(file)
-        .parse(input.as_slice().map(eoi, |(t, s)| (t, s)))
+    let parser = cached_item_parser(file);
+    let (item, errors) = parser
+        .get()
+        .parse(input.as_slice().map(eoi, split_token as SplitToken<'_>))
         .into_output_errors();
     for e in errors {
         diags.push(rich_to_diagnostic(&e, file));
@@ -511,6 +517,47 @@ fn rich_to_diagnostic(e: &Rich<'_, Tok, SimpleSpan>, file: FileId) -> Diagnostic
 }
 
 type Err<'t> = extra::Err<Rich<'t, Tok, SimpleSpan>>;
+
+/// What the item parser reads: an item's tokens with their relative spans.
+type ItemInput<'t> = MappedInput<'t, Tok, SimpleSpan, &'t [(Tok, SimpleSpan)], SplitToken<'t>>;
+type SplitToken<'t> = fn(&'t (Tok, SimpleSpan)) -> (&'t Tok, &'t SimpleSpan);
+
+fn split_token(pair: &(Tok, SimpleSpan)) -> (&Tok, &SimpleSpan) {
+    (&pair.0, &pair.1)
+}
+
+/// The item parser of one file, built once: building it (a few hundred
+/// combinators, a string per keyword) cost more than parsing a typical
+/// item, and a file has tens of thousands of items. chumsky's [`Cache`]
+/// holds it for inputs of any lifetime.
+struct ItemParser {
+    file: FileId,
+}
+
+impl Cached for ItemParser {
+    type Parser<'t> = Boxed<'t, 't, ItemInput<'t>, Item, Err<'t>>;
+
+    fn make_parser<'t>(self) -> Self::Parser<'t> {
+        item_parser(self.file).boxed()
+    }
+}
+
+thread_local! {
+    /// Per thread, since a parser shares its recursive parts through `Rc`;
+    /// per file, since the parser puts the file in every span it makes.
+    static ITEM_PARSERS: RefCell<HashMap<FileId, Rc<Cache<ItemParser>>>> =
+        RefCell::default();
+}
+
+fn cached_item_parser(file: FileId) -> Rc<Cache<ItemParser>> {
+    ITEM_PARSERS.with(|parsers| {
+        parsers
+            .borrow_mut()
+            .entry(file)
+            .or_insert_with(|| Rc::new(Cache::new(ItemParser { file })))
+            .clone()
+    })
+}
 
 fn kw<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
     word: &'static str,
