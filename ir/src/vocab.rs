@@ -379,6 +379,12 @@ fn entry(name: NodeName) -> &'static NodeSpec {
         .expect("every node name has its entry in NODES (vocab tests check it)")
 }
 
+impl NodeName {
+    pub fn spec(self) -> &'static NodeSpec {
+        entry(self)
+    }
+}
+
 impl ControlName {
     pub fn spec(self) -> &'static NodeSpec {
         entry(NodeName::Control(self))

@@ -283,13 +283,16 @@ impl Writer<'_, '_> {
     /// The node's ports as BT.CPP's `config().input_ports` holds them.
     fn ports(&self, n: &SNode) -> Vec<(String, String)> {
         let mut ports: Vec<(String, String)> = match &n.kind {
-            Kind::Parallel { success, failure } => vec![
-                ("success_count".into(), success.to_string()),
-                ("failure_count".into(), failure.to_string()),
-            ],
-            Kind::Retry(k) => vec![("num_attempts".into(), k.to_string())],
-            Kind::Repeat(k) => vec![("num_cycles".into(), k.to_string())],
-            Kind::Timeout(ms) => vec![("msec".into(), ms.to_string())],
+            Kind::Parallel { .. }
+            | Kind::Retry(_)
+            | Kind::Repeat(_)
+            | Kind::Timeout(_)
+            | Kind::Delay(_) => n
+                .kind
+                .vocab_ports()
+                .into_iter()
+                .map(|(k, v)| (k.to_owned(), v))
+                .collect(),
             Kind::Switch { variable, cases } => std::iter::once(("variable".into(), variable))
                 .chain(
                     cases
@@ -299,7 +302,6 @@ impl Writer<'_, '_> {
                 )
                 .map(|(k, v)| (k, port_text(v)))
                 .collect(),
-            Kind::Delay(ms) => vec![("delay_msec".into(), ms.to_string())],
             Kind::RunOnce { then_skip } => vec![("then_skip".into(), then_skip.to_string())],
             Kind::Precondition { code, otherwise } => vec![
                 ("if".into(), code.clone()),

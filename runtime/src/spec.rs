@@ -1,6 +1,7 @@
 //! A loaded tree before compilation: what the JSON IR and the XML loader
 //! both produce, so the two run through one builder (and give one trace).
 
+use btc_ir::vocab::NodeName;
 pub use btc_ir::NodeScripts;
 use btc_ir::{ControlKind, Count, DecoratorKind};
 use btc_ir::{LeafKind, Node, NodeModel, PortValue, StepInfo, TreeIr};
@@ -308,21 +309,15 @@ fn amount<T>(c: &Count, fixed: impl Fn(u64) -> T) -> Amount<T> {
 }
 
 /// The name BT.CPP gives a node without a `name`: its registration ID.
+/// A vocabulary node's is the table's BT.CPP tag; the others are BT.CPP
+/// nodes only the XML reader makes.
 pub fn default_name(k: &Kind) -> &str {
+    if let Some(name) = k.vocab() {
+        return name.spec().tag;
+    }
     match k {
-        Kind::Sequence => "Sequence",
-        Kind::ReactiveSequence => "ReactiveSequence",
         Kind::SequenceWithMemory => "SequenceWithMemory",
-        Kind::Fallback => "Fallback",
-        Kind::ReactiveFallback => "ReactiveFallback",
-        Kind::Parallel { .. } => "Parallel",
-        Kind::Inverter => "Inverter",
-        Kind::ForceSuccess => "ForceSuccess",
-        Kind::ForceFailure => "ForceFailure",
         Kind::KeepRunningUntilFailure => "KeepRunningUntilFailure",
-        Kind::Retry(_) => "RetryUntilSuccessful",
-        Kind::Repeat(_) => "Repeat",
-        Kind::Timeout(_) => "Timeout",
         Kind::IfThenElse => "IfThenElse",
         Kind::WhileDoElse => "WhileDoElse",
         Kind::Switch { cases, .. } => match cases.len() {
@@ -332,11 +327,71 @@ pub fn default_name(k: &Kind) -> &str {
             5 => "Switch5",
             _ => "Switch6",
         },
-        Kind::Delay(_) => "Delay",
-        Kind::RunOnce { .. } => "RunOnce",
         Kind::Precondition { .. } => "Precondition",
         Kind::SubTree { id, .. } => id,
         Kind::Step { .. } => "KbStep",
         Kind::Leaf { id, .. } => id,
+        // Answered by `vocab` above.
+        Kind::Sequence
+        | Kind::ReactiveSequence
+        | Kind::Fallback
+        | Kind::ReactiveFallback
+        | Kind::Parallel { .. }
+        | Kind::Inverter
+        | Kind::ForceSuccess
+        | Kind::ForceFailure
+        | Kind::Retry(_)
+        | Kind::Repeat(_)
+        | Kind::Timeout(_)
+        | Kind::Delay(_)
+        | Kind::RunOnce { .. } => unreachable!("a vocabulary node's name is its tag"),
+    }
+}
+
+impl Kind {
+    /// The node of the vocabulary ([`btc_ir::vocab::NODES`]) this kind
+    /// runs, or `None` for a BT.CPP node the rules language does not have.
+    /// No wildcard: a new kind has to say which it is.
+    pub fn vocab(&self) -> Option<NodeName> {
+        use btc_ir::{ControlName as C, DecoratorName as D};
+        Some(match self {
+            Kind::Sequence => NodeName::Control(C::Sequence),
+            Kind::ReactiveSequence => NodeName::Control(C::ReactiveSequence),
+            Kind::Fallback => NodeName::Control(C::Fallback),
+            Kind::ReactiveFallback => NodeName::Control(C::ReactiveFallback),
+            Kind::Parallel { .. } => NodeName::Control(C::Parallel),
+            Kind::Inverter => NodeName::Decorator(D::Inverter),
+            Kind::ForceSuccess => NodeName::Decorator(D::ForceSuccess),
+            Kind::ForceFailure => NodeName::Decorator(D::ForceFailure),
+            Kind::Retry(_) => NodeName::Decorator(D::Retry),
+            Kind::Repeat(_) => NodeName::Decorator(D::Repeat),
+            Kind::Timeout(_) => NodeName::Decorator(D::Timeout),
+            Kind::Delay(_) => NodeName::Decorator(D::Delay),
+            Kind::RunOnce { .. } => NodeName::Decorator(D::RunOnce),
+            Kind::SequenceWithMemory
+            | Kind::KeepRunningUntilFailure
+            | Kind::IfThenElse
+            | Kind::WhileDoElse
+            | Kind::Switch { .. }
+            | Kind::Precondition { .. }
+            | Kind::SubTree { .. }
+            | Kind::Step { .. }
+            | Kind::Leaf { .. } => return None,
+        })
+    }
+
+    /// A vocabulary node's parameters as BT.CPP's ports hold them: the
+    /// table's port names with this node's values, in the table's order
+    /// (empty for the others).
+    pub fn vocab_ports(&self) -> Vec<(&'static str, String)> {
+        let values: Vec<String> = match self {
+            Kind::Parallel { success, failure } => vec![success.to_string(), failure.to_string()],
+            Kind::Retry(k) | Kind::Repeat(k) => vec![k.to_string()],
+            Kind::Timeout(ms) | Kind::Delay(ms) => vec![ms.to_string()],
+            _ => Vec::new(),
+        };
+        let params = self.vocab().map_or(&[][..], |n| n.spec().params);
+        debug_assert_eq!(params.len(), values.len(), "{self:?}");
+        params.iter().map(|p| p.port).zip(values).collect()
     }
 }

@@ -10,6 +10,7 @@ use crate::error::LoadError;
 use crate::spec::{
     default_name, Amount, Kind, NodeScripts, SNode, StepConditions, TreeDoc, Verdict,
 };
+use btc_ir::vocab::{NodeName, NodeSpec};
 use btc_ir::{LeafKind, NodeModel, PortDirection, PortModel, PortValue};
 use btc_pddl::diagnostic::{codes, did_you_mean};
 use btc_pddl::logic::decode;
@@ -110,6 +111,29 @@ impl Elem {
         let v = self.get(k)?.trim();
         let key = v.strip_prefix('{')?.strip_suffix('}')?;
         (!key.is_empty()).then(|| key.to_owned())
+    }
+
+    /// A count (`num_attempts`): written out, or `{key}`.
+    fn times(&self, k: &str) -> Result<Amount<i32>, LoadError> {
+        Ok(match self.entry(k) {
+            Some(key) => Amount::Entry(key),
+            None => Amount::Fixed(self.count(k, None)?),
+        })
+    }
+
+    /// A duration in milliseconds (`msec`): written out, or `{key}`.
+    fn millis(&self, k: &str) -> Result<Amount<u64>, LoadError> {
+        if let Some(key) = self.entry(k) {
+            return Ok(Amount::Entry(key));
+        }
+        let ms = self.int(k, None)?;
+        u64::try_from(ms).map(Amount::Fixed).map_err(|_| {
+            LoadError::new(
+                codes::X_BAD_PORT,
+                format!("<{}>: `{k}` must not be negative", self.name),
+            )
+            .at(self.at)
+        })
     }
 
     fn count(&self, k: &str, default: Option<i64>) -> Result<i32, LoadError> {
@@ -225,6 +249,45 @@ const NOT_RUN: [&str; 12] = [
     "WasEntryUpdated",
 ];
 
+/// A node of the vocabulary ([`btc_ir::vocab::NODES`]), its attributes
+/// named by the table's ports. No wildcard: a node added to the table does
+/// not compile until the reader knows it.
+fn vocab_kind(spec: &NodeSpec, e: &Elem) -> Result<Kind, LoadError> {
+    use btc_ir::{ControlName as C, DecoratorName as D};
+    let port = |i: usize| spec.params[i].port;
+    Ok(match spec.name {
+        NodeName::Control(C::Sequence) => Kind::Sequence,
+        NodeName::Control(C::ReactiveSequence) => Kind::ReactiveSequence,
+        NodeName::Control(C::Fallback) => Kind::Fallback,
+        NodeName::Control(C::ReactiveFallback) => Kind::ReactiveFallback,
+        // BT.CPP's defaults: every child must succeed, one failure fails it.
+        NodeName::Control(C::Parallel) => Kind::Parallel {
+            success: e.count(port(0), Some(-1))?,
+            failure: e.count(port(1), Some(1))?,
+        },
+        NodeName::Decorator(D::Inverter) => Kind::Inverter,
+        NodeName::Decorator(D::ForceSuccess) => Kind::ForceSuccess,
+        NodeName::Decorator(D::ForceFailure) => Kind::ForceFailure,
+        NodeName::Decorator(D::Retry) => Kind::Retry(e.times(port(0))?),
+        NodeName::Decorator(D::Repeat) => Kind::Repeat(e.times(port(0))?),
+        NodeName::Decorator(D::Timeout) => Kind::Timeout(e.millis(port(0))?),
+        NodeName::Decorator(D::Delay) => Kind::Delay(e.millis(port(0))?),
+        NodeName::Decorator(D::RunOnce) => Kind::RunOnce {
+            then_skip: match e.get("then_skip").map(str::trim) {
+                None | Some("true") | Some("1") => true,
+                Some("false") | Some("0") => false,
+                Some(v) => {
+                    return Err(LoadError::new(
+                        codes::X_BAD_PORT,
+                        format!("<{}>: `then_skip=\"{v}\"` is not true or false", e.name),
+                    )
+                    .at(e.at))
+                }
+            },
+        },
+    })
+}
+
 fn node_of(mut e: Elem) -> Result<SNode, LoadError> {
     if NOT_RUN.contains(&e.name.as_str()) {
         return Err(LoadError::new(
@@ -239,154 +302,103 @@ fn node_of(mut e: Elem) -> Result<SNode, LoadError> {
     }
     let name = e.get("name").map(str::to_owned);
     let scripts = node_scripts(&mut e)?;
-    let kind = match e.name.as_str() {
-        "Sequence" => Kind::Sequence,
-        "ReactiveSequence" => Kind::ReactiveSequence,
-        "SequenceWithMemory" | "SequenceStar" => Kind::SequenceWithMemory,
-        "Fallback" => Kind::Fallback,
-        "ReactiveFallback" => Kind::ReactiveFallback,
-        "Parallel" => Kind::Parallel {
-            success: e.count("success_count", Some(-1))?,
-            failure: e.count("failure_count", Some(1))?,
-        },
-        "Inverter" => Kind::Inverter,
-        "ForceSuccess" => Kind::ForceSuccess,
-        "ForceFailure" => Kind::ForceFailure,
-        "KeepRunningUntilFailure" => Kind::KeepRunningUntilFailure,
-        "RetryUntilSuccessful" => Kind::Retry(match e.entry("num_attempts") {
-            Some(k) => Amount::Entry(k),
-            None => Amount::Fixed(e.count("num_attempts", None)?),
-        }),
-        "Repeat" => Kind::Repeat(match e.entry("num_cycles") {
-            Some(k) => Amount::Entry(k),
-            None => Amount::Fixed(e.count("num_cycles", None)?),
-        }),
-        "Timeout" => Kind::Timeout(match e.entry("msec") {
-            Some(k) => Amount::Entry(k),
-            None => {
-                let ms = e.int("msec", None)?;
-                Amount::Fixed(u64::try_from(ms).map_err(|_| {
-                    LoadError::new(codes::X_BAD_PORT, "<Timeout>: `msec` must not be negative")
-                        .at(e.at)
-                })?)
-            }
-        }),
-        "IfThenElse" => Kind::IfThenElse,
-        "WhileDoElse" => Kind::WhileDoElse,
-        "Switch2" | "Switch3" | "Switch4" | "Switch5" | "Switch6" => {
-            let n: usize = e.name["Switch".len()..].parse().unwrap_or(2);
-            let variable = e.get("variable").map(|v| port_value(v.to_owned()));
-            let variable = variable.ok_or_else(|| {
-                LoadError::new(
-                    codes::X_BAD_PORT,
-                    format!("<{}> needs the attribute `variable`", e.name),
-                )
-                .at(e.at)
-            })?;
-            let cases = (1..=n)
-                .map(|k| {
-                    e.get(&format!("case_{k}"))
-                        .map(|v| port_value(v.to_owned()))
-                        .unwrap_or(PortValue::Text(String::new()))
-                })
-                .collect();
-            Kind::Switch { variable, cases }
-        }
-        "Delay" => Kind::Delay(match e.entry("delay_msec") {
-            Some(k) => Amount::Entry(k),
-            None => {
-                let ms = e.int("delay_msec", None)?;
-                Amount::Fixed(u64::try_from(ms).map_err(|_| {
+    let kind = if let Some(spec) = NodeSpec::by_tag(&e.name) {
+        vocab_kind(spec, &e)?
+    } else {
+        match e.name.as_str() {
+            "SequenceWithMemory" | "SequenceStar" => Kind::SequenceWithMemory,
+            "KeepRunningUntilFailure" => Kind::KeepRunningUntilFailure,
+            "IfThenElse" => Kind::IfThenElse,
+            "WhileDoElse" => Kind::WhileDoElse,
+            "Switch2" | "Switch3" | "Switch4" | "Switch5" | "Switch6" => {
+                let n: usize = e.name["Switch".len()..].parse().unwrap_or(2);
+                let variable = e.get("variable").map(|v| port_value(v.to_owned()));
+                let variable = variable.ok_or_else(|| {
                     LoadError::new(
                         codes::X_BAD_PORT,
-                        "<Delay>: `delay_msec` must not be negative",
-                    )
-                    .at(e.at)
-                })?)
-            }
-        }),
-        "RunOnce" => Kind::RunOnce {
-            then_skip: match e.get("then_skip").map(str::trim) {
-                None | Some("true") | Some("1") => true,
-                Some("false") | Some("0") => false,
-                Some(v) => {
-                    return Err(LoadError::new(
-                        codes::X_BAD_PORT,
-                        format!("<RunOnce>: `then_skip=\"{v}\"` is not true or false"),
-                    )
-                    .at(e.at))
-                }
-            },
-        },
-        "Precondition" => Kind::Precondition {
-            code: e
-                .get("if")
-                .ok_or_else(|| {
-                    LoadError::new(codes::X_BAD_PORT, "<Precondition> needs the attribute `if`")
-                        .at(e.at)
-                })?
-                .to_owned(),
-            otherwise: verdict(&e, "else", Verdict::Failure)?,
-        },
-        "SubTree" => {
-            let id = e.get("ID").ok_or_else(|| {
-                LoadError::new(codes::X_BAD_PORT, "<SubTree> needs the attribute `ID`").at(e.at)
-            })?;
-            let id = id.to_owned();
-            let autoremap = e.get("_autoremap").is_some_and(|v| v.trim() == "true");
-            Kind::SubTree {
-                id,
-                ports: ports(&mut e, &["ID", "_autoremap"]),
-                autoremap,
-            }
-        }
-        "KbStep" => {
-            let step = e.int("step", None)?;
-            let step = usize::try_from(step)
-                .ok()
-                .filter(|s| *s >= 1)
-                .ok_or_else(|| {
-                    LoadError::new(
-                        codes::X_BAD_PORT,
-                        format!("<KbStep>: `step` counts from 1, not {step}"),
+                        format!("<{}> needs the attribute `variable`", e.name),
                     )
                     .at(e.at)
                 })?;
-            Kind::Step {
-                step: step - 1,
-                start_effect: pddl(&e, "start_effect", decode::effect, "an effect")?,
-                end_effect: pddl(&e, "end_effect", decode::effect, "an effect")?,
-                conditions: step_conditions(&e)?,
+                let cases = (1..=n)
+                    .map(|k| {
+                        e.get(&format!("case_{k}"))
+                            .map(|v| port_value(v.to_owned()))
+                            .unwrap_or(PortValue::Text(String::new()))
+                    })
+                    .collect();
+                Kind::Switch { variable, cases }
             }
-        }
-        // Groot 1 spelling: <Action ID="MoveTo" .../>.
-        "Action" | "Condition" => {
-            let id = e.get("ID").ok_or_else(|| {
-                LoadError::new(
-                    codes::X_BAD_PORT,
-                    format!("<{}> needs the attribute `ID`", e.name),
-                )
-                .at(e.at)
-            })?;
-            let id = id.to_owned();
-            let kind = Some(if e.name == "Action" {
-                LeafKind::Action
-            } else {
-                LeafKind::Condition
-            });
-            Kind::Leaf {
-                id,
-                kind,
-                ports: ports(&mut e, &["ID"]),
+            "Precondition" => Kind::Precondition {
+                code: e
+                    .get("if")
+                    .ok_or_else(|| {
+                        LoadError::new(codes::X_BAD_PORT, "<Precondition> needs the attribute `if`")
+                            .at(e.at)
+                    })?
+                    .to_owned(),
+                otherwise: verdict(&e, "else", Verdict::Failure)?,
+            },
+            "SubTree" => {
+                let id = e.get("ID").ok_or_else(|| {
+                    LoadError::new(codes::X_BAD_PORT, "<SubTree> needs the attribute `ID`").at(e.at)
+                })?;
+                let id = id.to_owned();
+                let autoremap = e.get("_autoremap").is_some_and(|v| v.trim() == "true");
+                Kind::SubTree {
+                    id,
+                    ports: ports(&mut e, &["ID", "_autoremap"]),
+                    autoremap,
+                }
             }
-        }
-        _ => {
-            let mut ps = ports(&mut e, &[]);
-            kb_ports(&e, &mut ps)?;
-            Kind::Leaf {
-                id: std::mem::take(&mut e.name),
-                kind: None,
-                ports: ps,
+            "KbStep" => {
+                let step = e.int("step", None)?;
+                let step = usize::try_from(step)
+                    .ok()
+                    .filter(|s| *s >= 1)
+                    .ok_or_else(|| {
+                        LoadError::new(
+                            codes::X_BAD_PORT,
+                            format!("<KbStep>: `step` counts from 1, not {step}"),
+                        )
+                        .at(e.at)
+                    })?;
+                Kind::Step {
+                    step: step - 1,
+                    start_effect: pddl(&e, "start_effect", decode::effect, "an effect")?,
+                    end_effect: pddl(&e, "end_effect", decode::effect, "an effect")?,
+                    conditions: step_conditions(&e)?,
+                }
+            }
+            // Groot 1 spelling: <Action ID="MoveTo" .../>.
+            "Action" | "Condition" => {
+                let id = e.get("ID").ok_or_else(|| {
+                    LoadError::new(
+                        codes::X_BAD_PORT,
+                        format!("<{}> needs the attribute `ID`", e.name),
+                    )
+                    .at(e.at)
+                })?;
+                let id = id.to_owned();
+                let kind = Some(if e.name == "Action" {
+                    LeafKind::Action
+                } else {
+                    LeafKind::Condition
+                });
+                Kind::Leaf {
+                    id,
+                    kind,
+                    ports: ports(&mut e, &["ID"]),
+                }
+            }
+            _ => {
+                let mut ps = ports(&mut e, &[]);
+                kb_ports(&e, &mut ps)?;
+                Kind::Leaf {
+                    id: std::mem::take(&mut e.name),
+                    kind: None,
+                    ports: ps,
+                }
             }
         }
     };

@@ -277,13 +277,16 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
             Kind::ReactiveFallback => Op::ReactiveFallback,
             Kind::Parallel { success, failure } => {
                 let c = n.children.len() as i64;
-                for (what, t) in [("success_count", *success), ("failure_count", *failure)] {
+                for ((what, _), t) in n.kind.vocab_ports().into_iter().zip([*success, *failure]) {
                     if threshold(t, c) > c {
                         return Err(self
                             .err(
                                 codes::X_BAD_PORT,
                                 n,
-                                format!("Parallel has {c} children, fewer than its {what} {t}"),
+                                format!(
+                                    "{} has {c} children, fewer than its {what} {t}",
+                                    default_name(&n.kind)
+                                ),
                             )
                             .hint(
                                 "BT.CPP refuses such a Parallel: it could never finish that way",
