@@ -963,6 +963,57 @@ mod tests {
         assert_eq!(ids, BTCPP_BUILTINS);
     }
 
+    /// The node vocabulary's BT.CPP side is BT.CPP 4.10's: each entry's tag
+    /// is a built-in (so the executor refuses to register it again), a
+    /// `<Control>` when it takes a block and a `<Decorator>` when it takes
+    /// one child, and each parameter is one of its input ports, of a C++
+    /// type that holds the table's range.
+    #[test]
+    fn the_vocabulary_agrees_with_btcpp_4_10s_models() {
+        use btc_ir::vocab::{Arity, ParamType, NODES};
+        let models = include_str!("../../runtime/src/btcpp_builtins.xml");
+        for spec in NODES {
+            assert!(BTCPP_BUILTINS.contains(&spec.tag), "{}", spec.tag);
+            let at = models
+                .find(&format!(" ID=\"{}\"", spec.tag))
+                .unwrap_or_else(|| panic!("no model for {}", spec.tag));
+            let element = models[..at].rsplit('<').next().unwrap();
+            let want = match spec.arity {
+                Arity::One => "Decorator",
+                Arity::AtLeast(_) => "Control",
+            };
+            assert_eq!(element, want, "{}", spec.tag);
+            let rest = &models[at..];
+            let body = match rest.find('>') {
+                Some(i) if rest[..i].ends_with('/') => "",
+                _ => &rest[..rest.find(&format!("</{element}>")).unwrap()],
+            };
+            for p in spec.params {
+                let decl = format!("<input_port name=\"{}\" type=\"", p.port);
+                let ty = body
+                    .split(&decl)
+                    .nth(1)
+                    .and_then(|r| r.split('"').next())
+                    .unwrap_or_else(|| panic!("{} has no input port {}", spec.tag, p.port));
+                let (min, max) = match ty {
+                    "int" => (i64::from(i32::MIN), i64::from(i32::MAX)),
+                    "unsigned int" => (0, i64::from(u32::MAX)),
+                    other => panic!("{}.{}: C++ type {other}", spec.tag, p.port),
+                };
+                assert!(
+                    min <= p.min && p.max <= max,
+                    "{}.{}: {}..={} does not fit `{ty}`",
+                    spec.tag,
+                    p.port,
+                    p.min,
+                    p.max
+                );
+                let unsigned = matches!(p.ty, ParamType::Millis);
+                assert_eq!(ty == "unsigned int", unsigned, "{}.{}", spec.tag, p.port);
+            }
+        }
+    }
+
     #[test]
     fn literals_escape_what_cpp_reads_specially() {
         assert_eq!(literal("a\"b\\c\n?"), "\"a\\\"b\\\\c\\n?\"");

@@ -86,6 +86,20 @@ pub struct Param {
     pub max: i64,
 }
 
+impl Param {
+    /// In markdown: `` `times` (`num_attempts`): count, 1 to 2147483647 ``.
+    pub fn describe(&self) -> String {
+        format!(
+            "`{}` (`{}`): {}, {} to {}",
+            self.name,
+            self.port,
+            self.ty.name(),
+            self.min,
+            self.max
+        )
+    }
+}
+
 /// How the py_trees emitter writes a node.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PyTrees {
@@ -187,7 +201,7 @@ pub static NODES: &[NodeSpec] = &[
                 ty: ParamType::Threshold,
                 what: "children that must succeed",
                 min: 0,
-                max: MILLIS_MAX,
+                max: COUNT_MAX,
             },
             Param {
                 name: "failure",
@@ -195,7 +209,7 @@ pub static NODES: &[NodeSpec] = &[
                 ty: ParamType::Threshold,
                 what: "children that may fail",
                 min: 0,
-                max: MILLIS_MAX,
+                max: COUNT_MAX,
             },
         ],
         label: "⇒ (success {success}, failure {failure})",
@@ -360,6 +374,23 @@ impl NodeSpec {
         })
     }
 
+    /// How a call is written, in markdown: `` `retry(N) T` ``.
+    pub fn shape(&self) -> String {
+        match (self.arity, self.params.is_empty()) {
+            (Arity::One, true) => format!("`{} T`", self.keyword),
+            (Arity::One, false) => format!("`{}(N) T`", self.keyword),
+            (Arity::AtLeast(_), true) => format!("`{} [\"name\"] {{ ... }}`", self.keyword),
+            (Arity::AtLeast(_), false) => {
+                let p: Vec<String> = self
+                    .params
+                    .iter()
+                    .map(|p| format!("{}: N", p.name))
+                    .collect();
+                format!("`{}({}) {{ ... }}`", self.keyword, p.join(", "))
+            }
+        }
+    }
+
     /// The keyword closest to `word` (for "did you mean"), when one is
     /// close enough to be a likely typo.
     pub fn closest(word: &str) -> Option<&'static NodeSpec> {
@@ -439,29 +470,7 @@ pub fn markdown_table() -> String {
         "| keyword | shape | BT.CPP | parameters (BT.CPP port) | py_trees | what it does |\n|---|---|---|---|---|---|\n",
     );
     for s in NODES {
-        let shape = match (s.arity, s.params.is_empty()) {
-            (Arity::One, true) => format!("`{} T`", s.keyword),
-            (Arity::One, false) => format!("`{}(N) T`", s.keyword),
-            (Arity::AtLeast(_), true) => format!("`{} [\"name\"] {{ ... }}`", s.keyword),
-            (Arity::AtLeast(_), false) => {
-                let p: Vec<String> = s.params.iter().map(|p| format!("{}: N", p.name)).collect();
-                format!("`{}({}) {{ ... }}`", s.keyword, p.join(", "))
-            }
-        };
-        let params: Vec<String> = s
-            .params
-            .iter()
-            .map(|p| {
-                format!(
-                    "`{}` (`{}`): {}, {} to {}",
-                    p.name,
-                    p.port,
-                    p.ty.name(),
-                    p.min,
-                    p.max
-                )
-            })
-            .collect();
+        let params: Vec<String> = s.params.iter().map(Param::describe).collect();
         let pytrees = match s.pytrees {
             PyTrees::Built { class, .. } => format!("`{class}`"),
             PyTrees::NotExpressible { .. } => "not expressible (E001)".to_owned(),
@@ -469,7 +478,7 @@ pub fn markdown_table() -> String {
         out.push_str(&format!(
             "| `{}` | {} | `{}` | {} | {} | {} |\n",
             s.keyword,
-            shape,
+            s.shape(),
             s.tag,
             if params.is_empty() {
                 "-".to_owned()

@@ -106,6 +106,9 @@ fn btcpp_only_kinds_are_not_vocabulary_nodes() {
         Kind::WhileDoElse,
     ] {
         assert_eq!(k.vocab(), None, "{k:?}");
-        assert!(btc_ir::NodeSpec::by_tag(default_name(&k)).is_none(), "{k:?}");
+        assert!(
+            btc_ir::NodeSpec::by_tag(default_name(&k)).is_none(),
+            "{k:?}"
+        );
     }
 }
