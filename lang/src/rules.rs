@@ -13,6 +13,7 @@ pub mod parse;
 pub mod reach;
 pub mod resolve;
 pub mod skip;
+pub mod typo;
 
 pub use ast::*;
 pub use parse::{parse_rules, ParsedRules};

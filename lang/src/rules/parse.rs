@@ -488,7 +488,8 @@ fn parse_item(
         .parse(input.as_slice().map(eoi, split_token as SplitToken<'_>))
         .into_output_errors();
     for e in errors {
-        diags.push(rich_to_diagnostic(&e, file));
+        let d = rich_to_diagnostic(&e, file);
+        diags.push(super::typo::keyword_hint(d, &input));
     }
     (item.unwrap_or(Item::Error { span: whole }), diags)
 }
