@@ -24,7 +24,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
             "btc-runtime",
         ],
     ),
-    ("btc-lsp", &["btc-files", "btc-lang", "btc-pddl"]),
+    ("btc-lsp", &["btc-files", "btc-ir", "btc-lang", "btc-pddl"]),
     ("btc-testkit", &[]),
     ("btc-files", &[]),
 ];

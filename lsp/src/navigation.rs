@@ -30,7 +30,9 @@ fn quoted(names: &[String]) -> String {
 /// The hover text at a byte offset.
 pub fn hover(a: &Analysis, offset: usize) -> Option<Hover> {
     let names = a.names_at(offset);
-    let (span, first) = *names.first()?;
+    let Some(&(span, first)) = names.first() else {
+        return keyword_hover(a, offset);
+    };
     let item = a.syntax.item_at(span.start)?;
     let text = match &first.target {
         Target::Action { .. } => {
@@ -199,6 +201,39 @@ pub fn hover(a: &Analysis, offset: usize) -> Option<Hover> {
             value: text,
         }),
         range: Some(a.range(span)),
+    })
+}
+
+/// A node keyword of a template (`retry`, `parallel`...): the vocabulary's
+/// summary, shape, BT.CPP element and parameters. Only where the word is a
+/// template's keyword: not a port name (`delay: 3`), not in a call's
+/// parentheses or a PDDL formula.
+fn keyword_hover(a: &Analysis, offset: usize) -> Option<Hover> {
+    let t = &a.syntax.tokens;
+    let i = t.at(offset)?;
+    let spec = btc_ir::NodeSpec::by_keyword(t.ident(i)?)?;
+    if t.punct(i + 1) == Some(":") || t.open_paren(i).is_some() || t.in_pddl(i) {
+        return None;
+    }
+    let item = a.syntax.item_at(t.toks[i].1.start)?;
+    if !matches!(a.items[item].item, Item::Rule(_) | Item::Tree(_)) {
+        return None;
+    }
+    let mut text = format!(
+        "{} — {}\n\nBT.CPP `<{}>`",
+        spec.shape(),
+        spec.summary,
+        spec.tag
+    );
+    for p in spec.params {
+        text.push_str(&format!("\n- {}", p.describe()));
+    }
+    Some(Hover {
+        contents: HoverContents::Markup(MarkupContent {
+            kind: MarkupKind::Markdown,
+            value: text,
+        }),
+        range: Some(a.range(t.toks[i].1)),
     })
 }
 

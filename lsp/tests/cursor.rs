@@ -386,7 +386,8 @@ cases! {
         refused_rule_head, refused_stdlib_node, rule_variable, tree_port,
     ];
     hover: [
-        capture, head_matching_two_actions, node_from_import, port, predicate,
+        capture, head_matching_two_actions, keyword_as_port_name, keyword_delay,
+        keyword_parallel, keyword_retry, node_from_import, port, predicate,
         pddl_type, rule_variable, table, tree_port_variable,
     ];
     highlight: [rule_variable, tree];
