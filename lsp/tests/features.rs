@@ -1,10 +1,11 @@
 //! Diagnostics, quick fixes, completion contexts, signature help,
 //! formatting and file watching, driven in process through the real LSP
-//! service on the examples. Hover, definition, references, rename,
-//! highlights, semantic tokens, inlay hints, symbols and code actions are
-//! `tests/cursor.rs` (fixtures with a cursor, results drawn on the
-//! source); `tests/service.rs` has their wire shapes and a smoke test over
-//! every example.
+//! service on fixtures (`tests/fixtures/ariac` and `p3_assembler` are
+//! copies of examples, so that editing an example does not break these).
+//! Hover, definition, references, rename, highlights, semantic tokens,
+//! inlay hints, symbols and code actions are `tests/cursor.rs` (fixtures
+//! with a cursor, results drawn on the source); `tests/service.rs` has
+//! their wire shapes and a smoke test over every example.
 
 mod common;
 
@@ -12,19 +13,52 @@ use common::{pos, repo, uri, TestClient};
 use serde_json::{json, Value};
 use std::path::PathBuf;
 
+fn fixture(path: &str) -> PathBuf {
+    repo().join("lsp/tests/fixtures").join(path)
+}
+
 fn ariac() -> PathBuf {
-    repo().join("examples/ariac/rules.btrules")
+    fixture("ariac/rules.btrules")
 }
 
 fn text_of(p: &std::path::Path) -> String {
     std::fs::read_to_string(p).unwrap()
 }
 
-fn codes(diags: &[Value]) -> Vec<String> {
-    diags
+/// The string `key` of each object of a list (an array `Value` or slice).
+fn each<'a>(list: impl IntoIterator<Item = &'a Value>, key: &str) -> Vec<&'a str> {
+    list.into_iter().map(|v| v[key].as_str().unwrap()).collect()
+}
+
+fn codes(diags: &[Value]) -> Vec<&str> {
+    each(diags, "code")
+}
+
+fn array(v: &Value) -> &Vec<Value> {
+    v.as_array().unwrap()
+}
+
+/// The code action titled `title` over `range` (the diagnostics given as
+/// context), its edits applied to `text`.
+async fn code_action(
+    c: &mut TestClient,
+    u: &url::Url,
+    text: &str,
+    range: Value,
+    diagnostics: Value,
+    title: &str,
+) -> String {
+    let actions = c
+        .request(
+            "textDocument/codeAction",
+            json!({ "textDocument": { "uri": u }, "range": range, "context": { "diagnostics": diagnostics } }),
+        )
+        .await;
+    let action = array(&actions)
         .iter()
-        .map(|d| d["code"].as_str().unwrap().to_owned())
-        .collect()
+        .find(|a| a["title"] == title)
+        .unwrap_or_else(|| panic!("no action `{title}`: {actions:#}"));
+    apply(text, &action["edit"]["changes"][u.as_str()])
 }
 
 fn range(d: &Value) -> [u64; 4] {
@@ -70,20 +104,15 @@ async fn diagnostics_appear_at_the_right_range_and_clear_when_fixed() {
         .contains("did you mean `Grasp`?"));
 
     // The quick fix replaces the name.
-    let actions = c
-        .request(
-            "textDocument/codeAction",
-            json!({ "textDocument": { "uri": u }, "range": diags[1]["range"], "context": { "diagnostics": [] } }),
-        )
-        .await;
-    let fix = actions
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|a| a["title"] == "change to `Grasp`")
-        .expect("a did-you-mean fix");
-    let edits = &fix["edit"]["changes"][u.as_str()];
-    let fixed = apply(&text, edits);
+    let fixed = code_action(
+        &mut c,
+        &u,
+        &text,
+        diags[1]["range"].clone(),
+        json!([]),
+        "change to `Grasp`",
+    )
+    .await;
     assert_eq!(fixed, text_of(&path));
 
     // Typing the fix clears the diagnostic.
@@ -95,7 +124,7 @@ async fn diagnostics_appear_at_the_right_range_and_clear_when_fixed() {
 #[tokio::test]
 async fn positions_count_utf16_units_after_non_ascii_text() {
     let mut c = TestClient::new().await;
-    let path = repo().join("lsp/tests/fixtures/unicode/rules.btrules");
+    let path = fixture("unicode/rules.btrules");
     let text = text_of(&path);
     let u = c.open(&path).await;
     let diags = c.diagnostics_for(&u).await;
@@ -130,7 +159,7 @@ async fn references_symbols_and_workspace_symbols() {
         )
         .await;
     // The declaration, the plan's monitor and two rule calls.
-    assert_eq!(refs.as_array().unwrap().len(), 4, "{refs:#?}");
+    assert_eq!(array(&refs).len(), 4, "{refs:#?}");
 
     let syms = c
         .request(
@@ -138,12 +167,7 @@ async fn references_symbols_and_workspace_symbols() {
             json!({ "textDocument": { "uri": u } }),
         )
         .await;
-    let names: Vec<&str> = syms
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|s| s["name"].as_str().unwrap())
-        .collect();
+    let names = each(array(&syms), "name");
     assert!(
         names.contains(&"MoveTo")
             && names.contains(&"rule (grasp ?robot ?part ?bin)")
@@ -154,12 +178,7 @@ async fn references_symbols_and_workspace_symbols() {
     let ws = c
         .request("workspace/symbol", json!({ "query": "grasp" }))
         .await;
-    let names: Vec<&str> = ws
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|s| s["name"].as_str().unwrap())
-        .collect();
+    let names = each(array(&ws), "name");
     assert!(
         names.contains(&"Grasp") && names.contains(&"rule (grasp ?robot ?part ?bin)"),
         "{names:?}"
@@ -168,10 +187,9 @@ async fn references_symbols_and_workspace_symbols() {
 
 async fn labels(c: &mut TestClient, u: &url::Url, line: u32, col: u32) -> Vec<String> {
     let r = c.at("textDocument/completion", u, line, col).await;
-    r.as_array()
-        .unwrap()
-        .iter()
-        .map(|i| i["label"].as_str().unwrap().to_owned())
+    each(array(&r), "label")
+        .into_iter()
+        .map(str::to_owned)
         .collect()
 }
 
@@ -231,7 +249,7 @@ async fn completion_knows_its_context() {
         "{preds:?}"
     );
 
-    let p3 = repo().join("examples/p3_assembler/rules.btrules");
+    let p3 = fixture("p3_assembler/rules.btrules");
     let p3text = text_of(&p3).replacen("marker_pick[op]", "marker_pick[]", 1);
     let u3 = c.open_text(&p3, &p3text).await;
     let (l, col) = pos(&p3text, "marker_pick[]", 12);
@@ -267,7 +285,7 @@ async fn semantic_tokens_inlay_hints_and_formatting() {
             json!({ "textDocument": { "uri": u } }),
         )
         .await;
-    let data = t["data"].as_array().unwrap();
+    let data = array(&t["data"]);
     assert_eq!(data.len() % 5, 0);
     // The first token is the first comment: line 0, column 0, type comment.
     let comment = btc_lsp::highlight::TOKEN_TYPES
@@ -293,9 +311,7 @@ async fn semantic_tokens_inlay_hints_and_formatting() {
         )
         .await;
     let (l, col) = pos(&text, "?bin) {", 4);
-    let h = hints
-        .as_array()
-        .unwrap()
+    let h = array(&hints)
         .iter()
         .find(|h| h["position"] == json!({ "line": l, "character": col }))
         .expect("a hint after ?bin");
@@ -327,19 +343,15 @@ async fn quick_fixes_write_the_pddl_effect_and_rule_stubs() {
     let u = c.open_text(&path, &text).await;
     let diags = c.diagnostics_for(&u).await;
     assert_eq!(codes(&diags), ["R005"]);
-    let actions = c
-        .request(
-            "textDocument/codeAction",
-            json!({ "textDocument": { "uri": u }, "range": diags[0]["range"], "context": { "diagnostics": diags } }),
-        )
-        .await;
-    let fix = actions
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|a| a["title"] == "write the PDDL action's effect")
-        .expect("the R005 fix");
-    let fixed = apply(&text, &fix["edit"]["changes"][u.as_str()]);
+    let fixed = code_action(
+        &mut c,
+        &u,
+        &text,
+        diags[0]["range"].clone(),
+        json!(diags),
+        "write the PDDL action's effect",
+    )
+    .await;
     assert!(
         fixed.contains("effect (and (not (attach ?part ?robot)) (on ?part ?agv))"),
         "{fixed}"
@@ -348,31 +360,24 @@ async fn quick_fixes_write_the_pddl_effect_and_rule_stubs() {
     assert!(c.diagnostics_for(&u).await.is_empty());
 
     // Stubs for the three uncovered actions, which then check clean.
-    let stubs = repo().join("lsp/tests/fixtures/stubs/rules.btrules");
+    let stubs = fixture("stubs/rules.btrules");
     let stext = text_of(&stubs);
     let us = c.open(&stubs).await;
-    let actions = c
-        .request(
-            "textDocument/codeAction",
-            json!({ "textDocument": { "uri": us }, "range": { "start": { "line": 0, "character": 0 }, "end": { "line": 0, "character": 0 } }, "context": { "diagnostics": [] } }),
-        )
-        .await;
-    let add = actions
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|a| a["title"] == "Add rule stubs for 3 uncovered domain actions")
-        .expect("the stub action");
-    let with_stubs = apply(&stext, &add["edit"]["changes"][us.as_str()]);
+    let with_stubs = code_action(
+        &mut c,
+        &us,
+        &stext,
+        json!({ "start": { "line": 0, "character": 0 }, "end": { "line": 0, "character": 0 } }),
+        json!([]),
+        "Add rule stubs for 3 uncovered domain actions",
+    )
+    .await;
     assert!(with_stubs.contains("rule (grasp ?robot ?part ?container) {\n    Grasp(robot: ?robot, part: ?part, container: ?container)\n}"), "{with_stubs}");
     let mut db = btc_lang::db::Database::new();
-    db.set_file(
-        "d/domain.pddl",
-        text_of(&repo().join("examples/ariac/domain.pddl")),
-    );
+    db.set_file("d/domain.pddl", text_of(&fixture("ariac/domain.pddl")));
     let f = db.set_file(
         "d/rules.btrules",
-        with_stubs.replace("../../../../examples/ariac/domain.pddl", "domain.pddl"),
+        with_stubs.replace("../ariac/domain.pddl", "domain.pddl"),
     );
     let left: Vec<&str> = btc_lang::db::rules_diagnostics(&db, f)
         .iter()
@@ -385,7 +390,7 @@ async fn quick_fixes_write_the_pddl_effect_and_rule_stubs() {
 async fn a_domain_changed_on_disk_rechecks_the_rules_that_use_it() {
     let dir = tempfile::tempdir().unwrap();
     for f in ["rules.btrules", "domain.pddl"] {
-        std::fs::copy(repo().join("examples/ariac").join(f), dir.path().join(f)).unwrap();
+        std::fs::copy(fixture("ariac").join(f), dir.path().join(f)).unwrap();
     }
     let mut c = TestClient::new().await;
     let u = c.open(&dir.path().join("rules.btrules")).await;
@@ -408,7 +413,7 @@ async fn a_domain_edited_in_the_editor_rechecks_the_rules_and_reports_its_own_er
     let mut c = TestClient::new().await;
     let u = c.open(&ariac()).await;
     assert!(c.diagnostics_for(&u).await.is_empty());
-    let domain = repo().join("examples/ariac/domain.pddl");
+    let domain = fixture("ariac/domain.pddl");
     let ud = url::Url::from_file_path(&domain).unwrap();
     assert_eq!(codes(&c.diagnostics_for(&ud).await), ["P108"]);
     let text = text_of(&domain).replace("(:action place", "(:action put");
