@@ -54,7 +54,10 @@ pub(super) fn tokens(src: &str) -> Result<Vec<(Tok, Range<usize>)>, SyntaxError>
                     span: start..src.len(),
                 });
             };
-            out.push((Tok::Str(src[i + 1..i + 1 + end].to_owned()), start..i + end + 2));
+            out.push((
+                Tok::Str(src[i + 1..i + 1 + end].to_owned()),
+                start..i + end + 2,
+            ));
             i += end + 2;
             continue;
         }

@@ -4,7 +4,12 @@ use super::{parse, Expr, Literal, Problem};
 
 fn error(src: &str) -> (Problem, std::ops::Range<usize>, String, String) {
     let e = parse(src).expect_err(src);
-    (e.problem.clone(), e.span.clone(), e.describe(), e.to_string())
+    (
+        e.problem.clone(),
+        e.span.clone(),
+        e.describe(),
+        e.to_string(),
+    )
 }
 
 #[test]
@@ -23,7 +28,10 @@ fn the_span_covers_the_bad_token() {
 
     let (_, span, describe, message) = error("x := 3foo");
     assert_eq!(span, 5..9);
-    assert_eq!(describe, "`3foo` is not a token of BT.CPP's scripting language");
+    assert_eq!(
+        describe,
+        "`3foo` is not a token of BT.CPP's scripting language"
+    );
     assert_eq!(message, "invalid token `3foo` at position 5");
 
     let (_, span, _, _) = error("x == 65.");

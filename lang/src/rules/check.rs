@@ -791,7 +791,9 @@ fn script_syntax(code: &StrLit, text: &str, e: &btc_script::SyntaxError) -> Diag
         span,
         format!("this script does not parse: {}", e.describe()),
     )
-    .with_hint("the script is BT.CPP's scripting language, described in docs/runtime.md (*Scripts*)")
+    .with_hint(
+        "the script is BT.CPP's scripting language, described in docs/runtime.md (*Scripts*)",
+    )
 }
 
 /// Checks one item. Spans in the result are relative to the item, like its tree.
