@@ -1,5 +1,7 @@
 //! The generated C++ executor (`btc executor`) runs btc's trees in real
 //! BehaviorTree.CPP exactly as `btc run` runs them: for every example, the
+//! values and scripts fixtures (the scripts are BT.CPP's own, so its
+//! `Script`, `ScriptCondition` and pre-/post-conditions run them), the
 //! workshop fixtures (`steps`, `steps backchained`, `steps parallel`) and
 //! every corpus domain with rules, each plan is compiled to BT.CPP XML (with
 //! and without `--inline`) and its world to a `.kb` file, run by the
@@ -86,6 +88,20 @@ fn rule_sets() -> Vec<RuleSet> {
         rules: values.join("rules.btrules"),
         jobs: vec![Job {
             plan: values.join("plan.txt"),
+            problem: values.join("problem.pddl"),
+            ticks: vec![0, 3],
+        }],
+    });
+    // BT.CPP scripts from the rules: `Script`/`ScriptCondition` leaves and
+    // the pre- and post-condition attributes (`_skipIf`, `_onSuccess`,
+    // `_failureIf`, `_successIf`, `_post`...), each rule tree's entries in
+    // its SubTree's blackboard (in one blackboard with `--inline`).
+    let scripts = repo().join("tests/fixtures/scripts");
+    sets.push(RuleSet {
+        name: "scripts".into(),
+        rules: scripts.join("rules.btrules"),
+        jobs: vec![Job {
+            plan: scripts.join("plan.txt"),
             problem: values.join("problem.pddl"),
             ticks: vec![0, 3],
         }],

@@ -11,9 +11,9 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ("btc-pddl", &[]),
     ("btc-ir", &["btc-pddl"]),
     ("btc-emit", &["btc-ir", "btc-pddl"]),
-    ("btc-lang", &["btc-ir", "btc-pddl"]),
+    ("btc-lang", &["btc-ir", "btc-pddl", "btc-script"]),
     ("btc-planner", &["btc-pddl"]),
-    ("btc-runtime", &["btc-ir", "btc-pddl"]),
+    ("btc-runtime", &["btc-ir", "btc-pddl", "btc-script"]),
     (
         "btc-agent",
         &[
@@ -27,6 +27,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ("btc-lsp", &["btc-files", "btc-ir", "btc-lang", "btc-pddl"]),
     ("btc-testkit", &[]),
     ("btc-files", &[]),
+    ("btc-script", &[]),
 ];
 
 /// Crates that may use the salsa database.

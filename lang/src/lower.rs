@@ -134,9 +134,11 @@ fn expand_tree(decl: &TreeDecl, args: &[Arg]) -> Vec<Template> {
                 other => parts.push(other.clone()),
             }
         }
+        // The parts are no longer the file's text: no offsets map back.
         StrLit {
             parts,
             span: s.span,
+            escapes: Vec::new(),
         }
     }
     fn template<'a>(t: &Template, arg: &dyn Fn(&str) -> Option<&'a Value>) -> Template {

@@ -337,6 +337,7 @@ pub mod codes {
         R_SCRIPT_KEY = "R120", "a script attribute on a node that is not one of BT.CPP's pre- or post-conditions";
         R_SCRIPT_TWICE = "R121", "a node that gives the same pre- or post-condition twice";
         R_SCRIPT_TEXT = "R122", "a script string that interpolates, which BT.CPP scripts cannot";
+        R_SCRIPT_SYNTAX = "R123", "a script that does not parse, which BT.CPP refuses when it loads the tree";
         // Emitting (btc compile --emit): what a target cannot express
         E_PYTREES_NODE = "E001", "a node a py_trees module cannot run as btc's engine does";
         // Running trees (btc run)

@@ -57,9 +57,24 @@ pub enum StrPart {
 pub struct StrLit {
     pub parts: Vec<StrPart>,
     pub span: Span,
+    /// Where the literal's text has a character written as an escape
+    /// (`\"`, `\\`, `\n`, `\t`, `\{`, `\}`: two bytes in the file for one
+    /// in the text): their offsets in the text, in order. What maps an
+    /// offset in a plain literal's text back into the file
+    /// ([`StrLit::source_offset`]); empty for strings btc makes itself.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub escapes: Vec<u32>,
 }
 
 impl StrLit {
+    /// Where byte `at` of a plain literal's text (see [`StrLit::plain`])
+    /// is in the file: after the opening quote, one more byte for each
+    /// escape before it. `at` may be the text's length (the closing quote).
+    pub fn source_offset(&self, at: usize) -> usize {
+        let escaped = self.escapes.partition_point(|&e| (e as usize) < at);
+        self.span.start as usize + 1 + at + escaped
+    }
+
     /// The text when the literal has no interpolation.
     pub fn plain(&self) -> Option<String> {
         let mut s = String::new();

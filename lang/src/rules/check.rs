@@ -215,9 +215,15 @@ impl Tcx<'_> {
     }
 
     /// A script is BT.CPP code, passed through as written: `{...}` in it
-    /// would be a btc interpolation BT.CPP never sees.
+    /// would be a btc interpolation BT.CPP never sees. Its syntax is
+    /// checked here, so that a script BT.CPP (and `btc run`) would refuse
+    /// when it loads the tree is shown at the token in the string.
     fn script_text(&mut self, code: &StrLit) {
-        if code.plain().is_none() {
+        if let Some(text) = code.plain() {
+            if let Err(e) = btc_script::parse(&text) {
+                self.err(script_syntax(code, &text, &e));
+            }
+        } else {
             self.err(
                 Diagnostic::error(
                     codes::R_SCRIPT_TEXT,
@@ -762,6 +768,32 @@ fn scope_of(vars: &[(String, Option<Vec<TypeId>>)]) -> Vec<(String, Vec<TypeId>)
             )
         })
         .collect()
+}
+
+/// R123 for a plain script literal `code` (whose text is `text`) that does
+/// not parse: the span is the bad token's in the file, through the
+/// literal's escapes; at the end of the script, the closing quote.
+fn script_syntax(code: &StrLit, text: &str, e: &btc_script::SyntaxError) -> Diagnostic {
+    let span = if e.problem == btc_script::Problem::Empty {
+        code.span
+    } else if e.span.is_empty() {
+        let at = code.source_offset(text.len());
+        Span::new(code.span.file, at, at + 1)
+    } else {
+        Span::new(
+            code.span.file,
+            code.source_offset(e.span.start),
+            code.source_offset(e.span.end),
+        )
+    };
+    Diagnostic::error(
+        codes::R_SCRIPT_SYNTAX,
+        span,
+        format!("this script does not parse: {}", e.describe()),
+    )
+    .with_hint(
+        "the script is BT.CPP's scripting language, described in docs/runtime.md (*Scripts*)",
+    )
 }
 
 /// Checks one item. Spans in the result are relative to the item, like its tree.

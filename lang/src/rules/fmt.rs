@@ -383,6 +383,7 @@ fn operand(o: &Operand) -> String {
                 text: name.text.clone(),
             }],
             span: name.span,
+            escapes: Vec::new(),
         }),
     }
 }

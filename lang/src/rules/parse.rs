@@ -623,6 +623,7 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
                 StrLit {
                     span: Span::new(file, span.start, span.end),
                     parts: vec![StrPart::Text { text: raw }],
+                    escapes: Vec::new(),
                 }
             })
         })
@@ -1065,13 +1066,21 @@ fn interpolate(raw: &str, file: FileId, start: usize) -> Result<StrLit, (String,
     let mut parts = Vec::new();
     let mut text = String::new();
     let base = start + 1;
+    let mut escapes = Vec::new();
+    // The text's length in the parts before `text`.
+    let mut done = 0;
     let mut chars = raw.char_indices().peekable();
     while let Some((i, c)) = chars.next() {
         match c {
             '\\' => match chars.next() {
-                Some((_, 'n')) => text.push('\n'),
-                Some((_, 't')) => text.push('\t'),
-                Some((_, c @ ('\\' | '"' | '{' | '}'))) => text.push(c),
+                Some((_, c @ ('n' | 't' | '\\' | '"' | '{' | '}'))) => {
+                    escapes.push((done + text.len()) as u32);
+                    text.push(match c {
+                        'n' => '\n',
+                        't' => '\t',
+                        c => c,
+                    });
+                }
                 Some((j, c)) => {
                     return Err((format!("`\\{c}` is not an escape; use `\\\\`, `\\\"`, `\\n`, `\\t`, `\\{{` or `\\}}`"), SimpleSpan::from(base + i..base + j + c.len_utf8())))
                 }
@@ -1092,6 +1101,7 @@ fn interpolate(raw: &str, file: FileId, start: usize) -> Result<StrLit, (String,
                     return Err((format!("`{{{inner}}}` is not `{{?variable}}` or `{{capture}}`"), SimpleSpan::from(base + i..base + close + 1)));
                 }
                 if !text.is_empty() {
+                    done += text.len();
                     parts.push(StrPart::Text { text: std::mem::take(&mut text) });
                 }
                 parts.push(if is_var {
@@ -1112,6 +1122,7 @@ fn interpolate(raw: &str, file: FileId, start: usize) -> Result<StrLit, (String,
     Ok(StrLit {
         parts,
         span: Span::new(file, start, start + raw.len() + 2),
+        escapes,
     })
 }
 
@@ -1208,6 +1219,28 @@ mod tests {
         assert_eq!(s.parts.len(), 5);
         assert!(matches!(&s.parts[1], StrPart::Var { name } if name.text == "robot"));
         assert!(matches!(&s.parts[4], StrPart::Text { text } if text == " {x}"));
+    }
+
+    #[test]
+    fn escapes_map_offsets_in_the_text_back_into_the_file() {
+        let src = r#"tree T() { sequence "a\"b\\c\n{?x}d" { } }"#;
+        let p = parse(src);
+        assert!(p.diagnostics.is_empty(), "{:#?}", p.diagnostics);
+        let Item::Tree(t) = &p.items[0].item else {
+            panic!()
+        };
+        let Template::Control { name: Some(s), .. } = &t.body[0] else {
+            panic!()
+        };
+        // a " b \ c \n: the escapes are the text's bytes 1, 3 and 5.
+        assert_eq!(s.escapes, [1, 3, 5]);
+        let open = src.find('"').unwrap();
+        assert_eq!(s.span.start as usize, open);
+        assert_eq!(s.source_offset(0), open + 1);
+        // `b` comes after `\"`, `c` after two escapes, the newline is at its `\`.
+        assert_eq!(&src[s.source_offset(2)..][..1], "b");
+        assert_eq!(&src[s.source_offset(4)..][..1], "c");
+        assert_eq!(&src[s.source_offset(5)..][..2], "\\n");
     }
 
     #[test]

@@ -2,8 +2,7 @@
 //! booleans; arithmetic computes in doubles; strings meet numbers only in
 //! comparisons (a string is read as a number there) and in `..`.
 
-use super::parse::{Assign, Binary, Compare, Expr, Unary};
-use super::{ErrorClass, ScriptError};
+use super::{Assign, Binary, Compare, ErrorClass, Expr, Literal, ScriptError, Unary};
 use crate::engine::Value;
 
 /// The blackboard a script reads and writes, by variable index.
@@ -139,7 +138,11 @@ pub fn truthy(v: &Value) -> Result<bool, ScriptError> {
 /// Evaluates one expression.
 pub fn eval(e: &Expr, env: &mut dyn Env) -> Result<Value, ScriptError> {
     Ok(match e {
-        Expr::Lit(v) => v.clone(),
+        Expr::Lit(l) => match l {
+            Literal::Int(n) => Value::Int(*n),
+            Literal::Float(f) => Value::Float(*f),
+            Literal::Text(s) => Value::Text(s.clone()),
+        },
         Expr::Var(k) => env
             .get(*k)
             .cloned()

@@ -1,20 +1,42 @@
 //! BehaviorTree.CPP's scripting language (`Script`, `ScriptCondition`,
 //! `Precondition` and the `_skipIf`/`_onSuccess`... attributes): text is
-//! read once, when the tree is built, into an expression tree whose
-//! variables are blackboard slots; a tick evaluates it over the blackboard
-//! with BT.CPP's value rules (numbers compute as doubles, integer literals
-//! stay integers until they meet an operator, `true`/`false` are 1 and 0).
-//! The differences from BT.CPP that are intended are listed in
-//! `docs/runtime.md`.
+//! read once, when the tree is built, into an expression tree (the syntax
+//! is crate `btc-script`'s, which the rules checker parses with too) whose
+//! variables become blackboard slots; a tick evaluates it over the
+//! blackboard with BT.CPP's value rules (numbers compute as doubles,
+//! integer literals stay integers until they meet an operator,
+//! `true`/`false` are 1 and 0). The differences from BT.CPP that are
+//! intended are listed in `docs/runtime.md`.
 
 mod eval;
-mod lex;
-mod parse;
 
+pub use btc_script::{Assign, Binary, Compare, Expr, Literal, Unary};
 pub use eval::{eval, truthy};
-pub use parse::{parse, Script};
 
 use std::fmt;
+
+/// A parsed script: its statements and the variables they name.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Script {
+    pub statements: Vec<Expr>,
+    pub vars: Vec<String>,
+}
+
+/// Parses a script (statements separated by `;`); a syntax error is of
+/// class [`ErrorClass::Syntax`], at the bad token's offset.
+pub fn parse(src: &str) -> Result<Script, ScriptError> {
+    match btc_script::parse(src) {
+        Ok(s) => Ok(Script {
+            statements: s.statements,
+            vars: s.vars,
+        }),
+        Err(e) => Err(ScriptError {
+            class: ErrorClass::Syntax,
+            message: e.to_string(),
+            at: Some(e.span.start),
+        }),
+    }
+}
 
 /// What kind of error a script met: the classes BT.CPP's own messages fall
 /// into, so that the two evaluators can be compared.

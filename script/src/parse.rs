@@ -3,8 +3,9 @@
 //! chain, `|` `^`, `&`, `+` `-` `..`, `*` `/`, and the prefix operators).
 
 use super::lex::{tokens, Tok};
-use super::{ErrorClass, ScriptError};
-use crate::engine::Value;
+use super::{Problem, SyntaxError};
+use std::ops::Range;
+use std::rc::Rc;
 
 /// How deeply a script may nest (brackets, prefix operators, right-hand
 /// sides); deeper scripts are refused rather than recursed into.
@@ -53,9 +54,19 @@ pub enum Assign {
     Div,
 }
 
+/// A literal as BT.CPP reads it: integers stay integers until they meet
+/// an operator; `true` and `false` are the doubles 1 and 0.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Literal {
+    Int(i64),
+    Float(f64),
+    /// Shared, so that evaluating the literal copies no text.
+    Text(Rc<str>),
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub enum Expr {
-    Lit(Value),
+    Lit(Literal),
     /// A variable: an index into [`Script::vars`].
     Var(u32),
     Unary(Unary, Box<Expr>),
@@ -75,7 +86,7 @@ pub struct Script {
 }
 
 /// Parses a script (statements separated by `;`).
-pub fn parse(src: &str) -> Result<Script, ScriptError> {
+pub fn parse(src: &str) -> Result<Script, SyntaxError> {
     let toks = tokens(src)?;
     let mut p = Parser {
         toks,
@@ -90,10 +101,9 @@ pub fn parse(src: &str) -> Result<Script, ScriptError> {
         }
     }
     if statements.is_empty() {
-        return Err(ScriptError {
-            class: ErrorClass::Syntax,
-            message: "the script is empty".into(),
-            at: Some(0),
+        return Err(SyntaxError {
+            problem: Problem::Empty,
+            span: 0..0,
         });
     }
     Ok(Script {
@@ -103,7 +113,7 @@ pub fn parse(src: &str) -> Result<Script, ScriptError> {
 }
 
 struct Parser {
-    toks: Vec<(Tok, usize)>,
+    toks: Vec<(Tok, Range<usize>)>,
     pos: usize,
     vars: Vec<String>,
 }
@@ -133,8 +143,8 @@ impl Parser {
         &self.toks[self.pos].0
     }
 
-    fn at(&self) -> usize {
-        self.toks[self.pos].1
+    fn span(&self) -> Range<usize> {
+        self.toks[self.pos].1.clone()
     }
 
     fn next(&mut self) -> Tok {
@@ -145,15 +155,14 @@ impl Parser {
         t
     }
 
-    fn error(&self, what: &str) -> ScriptError {
+    fn error(&self, expected: &'static str) -> SyntaxError {
         let got = match self.peek() {
-            Tok::End => "the end".to_owned(),
-            t => format!("`{}`", show(t)),
+            Tok::End => None,
+            t => Some(show(t)),
         };
-        ScriptError {
-            class: ErrorClass::Syntax,
-            message: format!("{what} at position {}, got {got}", self.at()),
-            at: Some(self.at()),
+        SyntaxError {
+            problem: Problem::Unexpected { expected, got },
+            span: self.span(),
         }
     }
 
@@ -167,15 +176,14 @@ impl Parser {
         }
     }
 
-    fn prefix(&mut self, depth: usize) -> Result<Expr, ScriptError> {
+    fn prefix(&mut self, depth: usize) -> Result<Expr, SyntaxError> {
         if depth > MAX_NESTING {
-            return Err(ScriptError {
-                class: ErrorClass::Syntax,
-                message: format!("the script nests deeper than {MAX_NESTING} levels"),
-                at: Some(self.at()),
+            return Err(SyntaxError {
+                problem: Problem::TooDeep,
+                span: self.span(),
             });
         }
-        let unary = |p: &mut Parser, op| -> Result<Expr, ScriptError> {
+        let unary = |p: &mut Parser, op| -> Result<Expr, SyntaxError> {
             p.pos += 1;
             Ok(Expr::Unary(op, Box::new(p.expr(PREFIX, depth + 1)?)))
         };
@@ -194,19 +202,19 @@ impl Parser {
             }
             Tok::Bool(b) => {
                 self.pos += 1;
-                Ok(Expr::Lit(Value::Float(if b { 1.0 } else { 0.0 })))
+                Ok(Expr::Lit(Literal::Float(if b { 1.0 } else { 0.0 })))
             }
             Tok::Int(n) => {
                 self.pos += 1;
-                Ok(Expr::Lit(Value::Int(n)))
+                Ok(Expr::Lit(Literal::Int(n)))
             }
             Tok::Real(f) => {
                 self.pos += 1;
-                Ok(Expr::Lit(Value::Float(f)))
+                Ok(Expr::Lit(Literal::Float(f)))
             }
             Tok::Str(s) => {
                 self.pos += 1;
-                Ok(Expr::Lit(Value::Text(s.as_str().into())))
+                Ok(Expr::Lit(Literal::Text(s.as_str().into())))
             }
             Tok::Ident(name) => {
                 self.pos += 1;
@@ -216,7 +224,7 @@ impl Parser {
         }
     }
 
-    fn expr(&mut self, min: u8, depth: usize) -> Result<Expr, ScriptError> {
+    fn expr(&mut self, min: u8, depth: usize) -> Result<Expr, SyntaxError> {
         let mut left = self.prefix(depth)?;
         while let Some(bp) = infix(self.peek()) {
             if bp < min {

@@ -1,7 +1,8 @@
 //! Script tokens. Numbers glued to letters (`3foo`), `65.` and an
 //! unterminated string are error tokens, as in BT.CPP.
 
-use super::{ErrorClass, ScriptError};
+use super::{Problem, SyntaxError};
+use std::ops::Range;
 
 #[derive(Clone, Debug, PartialEq)]
 pub(super) enum Tok {
@@ -30,15 +31,14 @@ fn ident_char(c: u8) -> bool {
     c.is_ascii_alphanumeric() || c == b'_'
 }
 
-/// The tokens of `src` with their byte offsets; the last is `End`.
-pub(super) fn tokens(src: &str) -> Result<Vec<(Tok, usize)>, ScriptError> {
+/// The tokens of `src` with their byte ranges; the last is `End`.
+pub(super) fn tokens(src: &str) -> Result<Vec<(Tok, Range<usize>)>, SyntaxError> {
     let b = src.as_bytes();
     let mut out = Vec::new();
     let mut i = 0;
-    let bad = |at: usize, what: &str| ScriptError {
-        class: ErrorClass::Syntax,
-        message: format!("invalid token `{what}` at position {at}"),
-        at: Some(at),
+    let bad = |at: usize, end: usize| SyntaxError {
+        problem: Problem::BadToken(src[at..end].to_owned()),
+        span: at..end,
     };
     while i < b.len() {
         let c = b[i];
@@ -49,15 +49,21 @@ pub(super) fn tokens(src: &str) -> Result<Vec<(Tok, usize)>, ScriptError> {
         }
         if c == b'\'' {
             let Some(end) = src[i + 1..].find('\'') else {
-                return Err(bad(start, &src[start..]));
+                return Err(SyntaxError {
+                    problem: Problem::Unterminated(src[start..].to_owned()),
+                    span: start..src.len(),
+                });
             };
-            out.push((Tok::Str(src[i + 1..i + 1 + end].to_owned()), start));
+            out.push((
+                Tok::Str(src[i + 1..i + 1 + end].to_owned()),
+                start..i + end + 2,
+            ));
             i += end + 2;
             continue;
         }
         if c.is_ascii_digit() {
-            let (tok, end) = number(src, i).map_err(|end| bad(start, &src[start..end]))?;
-            out.push((tok, start));
+            let (tok, end) = number(src, i).map_err(|end| bad(start, end))?;
+            out.push((tok, start..end));
             i = end;
             continue;
         }
@@ -73,24 +79,24 @@ pub(super) fn tokens(src: &str) -> Result<Vec<(Tok, usize)>, ScriptError> {
                     "false" => Tok::Bool(false),
                     _ => Tok::Ident(w.to_owned()),
                 },
-                start,
+                start..i,
             ));
             continue;
         }
         if let Some(op) = TWO.iter().find(|op| src[i..].starts_with(**op)) {
-            out.push((Tok::Op(op), start));
+            out.push((Tok::Op(op), start..start + 2));
             i += 2;
             continue;
         }
         if let Some(op) = ONE.iter().find(|op| op.as_bytes()[0] == c) {
-            out.push((Tok::Op(op), start));
+            out.push((Tok::Op(op), start..start + 1));
             i += 1;
             continue;
         }
-        let ch = src[i..].chars().next().unwrap_or('?');
-        return Err(bad(start, &ch.to_string()));
+        let len = src[i..].chars().next().map_or(1, char::len_utf8);
+        return Err(bad(start, start + len));
     }
-    out.push((Tok::End, b.len()));
+    out.push((Tok::End, b.len()..b.len()));
     Ok(out)
 }
 
