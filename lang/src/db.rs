@@ -210,22 +210,43 @@ pub fn file_id(_db: &dyn Db, f: SourceFile) -> FileId {
     f.as_id().index()
 }
 
+/// A rules file parsed, and the interned text each item was parsed from
+/// (`None` for a palette's items), which [`rules_items`] points to
+/// instead of copying the items.
+#[derive(Clone, Debug, PartialEq, salsa::SalsaValue)]
+pub struct ParsedFile<'db> {
+    pub rules: ParsedRules,
+    pub texts: Vec<Option<ItemText<'db>>>,
+}
+
 /// A rules file parsed. Items are parsed through [`parsed_item`], so an
 /// edit re-parses only the items whose text it changed.
 #[salsa::tracked(returns(ref))]
-pub fn parsed_rules(db: &dyn Db, file: SourceFile) -> ParsedRules {
+pub fn parsed_file(db: &dyn Db, file: SourceFile) -> ParsedFile<'_> {
     if is_palette(file.path(db)) {
         let (items, diagnostics) =
             crate::rules::palette::parse_palette(file.text(db), file_id(db, file));
-        return ParsedRules {
-            items,
-            comments: Vec::new(),
-            diagnostics,
+        return ParsedFile {
+            texts: vec![None; items.len()],
+            rules: ParsedRules {
+                items,
+                comments: Vec::new(),
+                diagnostics,
+            },
         };
     }
-    parse_rules_with(file.text(db), file_id(db, file), |text| {
-        parsed_item(db, ItemText::new(db, file, text.to_owned())).clone()
-    })
+    let mut texts = Vec::new();
+    let rules = parse_rules_with(file.text(db), file_id(db, file), |text| {
+        let t = ItemText::new(db, file, text.to_owned());
+        texts.push(Some(t));
+        parsed_item(db, t).clone()
+    });
+    ParsedFile { rules, texts }
+}
+
+/// A rules file parsed (see [`parsed_file`]).
+pub fn parsed_rules(db: &dyn Db, file: SourceFile) -> &ParsedRules {
+    &parsed_file(db, file).rules
 }
 
 /// A rules file's tokens and comments (spans in file 0: positions, not
@@ -278,11 +299,32 @@ pub struct RulesItem<'db> {
     #[returns(ref)]
     pub key: String,
     #[tracked]
-    #[returns(ref)]
-    pub item: Item,
+    #[returns(copy)]
+    pub source: ItemSource<'db>,
     #[tracked]
     #[returns(copy)]
     pub offset: u32,
+}
+
+/// Where a [`RulesItem`]'s tree is kept: the memo of the text it was
+/// parsed from, or (a palette's items) its place in the parsed file.
+/// Pointing there instead of holding a copy saved copying every item of a
+/// huge file once more; equal texts are still one id, so an edit
+/// elsewhere leaves the item's queries alone.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, salsa::SalsaValue)]
+pub enum ItemSource<'db> {
+    Text(ItemText<'db>),
+    Palette(usize),
+}
+
+impl<'db> RulesItem<'db> {
+    /// The item's tree, with spans relative to its start.
+    pub fn item(self, db: &'db dyn Db) -> &'db Item {
+        match self.source(db) {
+            ItemSource::Text(t) => &parsed_item(db, t).0,
+            ItemSource::Palette(k) => &parsed_rules(db, self.file(db)).items[k].item,
+        }
+    }
 }
 
 fn item_key(item: &Item) -> String {
@@ -317,17 +359,25 @@ fn item_key(item: &Item) -> String {
 #[salsa::tracked(returns(ref))]
 pub fn rules_items(db: &dyn Db, file: SourceFile) -> Vec<RulesItem<'_>> {
     let mut seen: std::collections::HashMap<String, u32> = std::collections::HashMap::new();
-    parsed_rules(db, file)
+    let parsed = parsed_file(db, file);
+    parsed
+        .rules
         .items
         .iter()
-        .map(|n| {
+        .zip(&parsed.texts)
+        .enumerate()
+        .map(|(k, (n, text))| {
             let mut key = item_key(&n.item);
             let count = seen.entry(key.clone()).or_insert(0);
             if *count > 0 {
                 key = format!("{key} #{count}");
             }
             *count += 1;
-            RulesItem::new(db, file, key, n.item.clone(), n.offset)
+            let source = match text {
+                Some(t) => ItemSource::Text(*t),
+                None => ItemSource::Palette(k),
+            };
+            RulesItem::new(db, file, key, source, n.offset)
         })
         .collect()
 }

@@ -119,6 +119,27 @@ fn starts_something(text: &str, i: usize) -> bool {
 /// the parser on top is chumsky. Never fails: bad characters become
 /// [`Tok::Error`] tokens with a diagnostic.
 pub fn lex(text: &str, file: FileId) -> Lexed {
+    lex_keeping(text, file, None)
+}
+
+/// [`lex`] for cutting a file into items: the same tokens, spans, comments
+/// and diagnostics, but a name is kept only if `keep` accepts it (others
+/// are empty, as are variables and strings). Every token of a huge file
+/// is then no allocation: only its items are lexed again with their names.
+pub fn lex_for_cutting(text: &str, file: FileId, keep: &dyn Fn(&str) -> bool) -> Lexed {
+    lex_keeping(text, file, Some(keep))
+}
+
+/// Lexes, keeping every name (`keep` is `None`) or those it accepts.
+fn lex_keeping(text: &str, file: FileId, keep: Option<&dyn Fn(&str) -> bool>) -> Lexed {
+    let all = keep.is_none();
+    let owned = |s: &str| {
+        if keep.is_none_or(|k| k(s)) {
+            s.to_owned()
+        } else {
+            String::new()
+        }
+    };
     let b = text.as_bytes();
     let mut out = Lexed {
         tokens: Vec::new(),
@@ -185,7 +206,11 @@ pub fn lex(text: &str, file: FileId) -> Lexed {
             let j = j.min(b.len());
             if closed {
                 i = j + 1;
-                Tok::Str(text[start + 1..j].to_owned())
+                Tok::Str(if all {
+                    text[start + 1..j].to_owned()
+                } else {
+                    String::new()
+                })
             } else {
                 i = j;
                 errors.push(
@@ -197,13 +222,21 @@ pub fn lex(text: &str, file: FileId) -> Lexed {
                     )
                     .with_hint("strings end on the line they start on"),
                 );
-                Tok::Str(text[start + 1..j].to_owned())
+                Tok::Str(if all {
+                    text[start + 1..j].to_owned()
+                } else {
+                    String::new()
+                })
             }
         } else if c == b'?' && char_at(text, i + 1).is_some_and(is_ident_start) {
             let first = char_at(text, i + 1).map_or(1, char::len_utf8);
             let j = ident_end(text, i + 1 + first);
             i = j;
-            Tok::Var(text[start + 1..j].to_owned())
+            Tok::Var(if all {
+                text[start + 1..j].to_owned()
+            } else {
+                String::new()
+            })
         } else if c.is_ascii_digit() || (c == b'-' && b.get(i + 1).is_some_and(u8::is_ascii_digit))
         {
             let mut j = i + 1;
@@ -228,7 +261,7 @@ pub fn lex(text: &str, file: FileId) -> Lexed {
         } else if let Some(first) = char_at(text, i).filter(|c| is_ident_start(*c)) {
             let j = ident_end(text, i + first.len_utf8());
             i = j;
-            Tok::Ident(text[start..j].to_owned())
+            Tok::Ident(owned(&text[start..j]))
         } else if let Some(p) = TWO_CHAR_PUNCTS
             .iter()
             .find(|p| b[i..].starts_with(p.as_bytes()))

@@ -4,7 +4,7 @@
 //! becomes [`Item::Error`] and the others still parse.
 
 use super::ast::*;
-use super::lexer::{lex, Comment, Tok};
+use super::lexer::{lex, lex_for_cutting, Comment, Tok};
 use btc_ir::vocab::{Arity, ControlName, NodeSpec};
 use btc_pddl::diagnostic::{codes, Diagnostic};
 use btc_pddl::lexer::{Tok as PTok, Token as PToken};
@@ -136,9 +136,11 @@ pub fn parse_rules_with(
     file: FileId,
     mut parse_item: impl FnMut(&str) -> (Item, Vec<Diagnostic>),
 ) -> ParsedRules {
-    let lexed = lex(text, file);
+    // Cutting needs only the item keywords' names: the other tokens'
+    // names are left unallocated (each item is lexed again to parse it).
+    let lexed = lex_for_cutting(text, file, &|w| ITEM_KEYWORDS.contains(&w));
     let mut diagnostics = lexed.diagnostics;
-    let mut items = Vec::new();
+    let mut items = Vec::with_capacity(lexed.tokens.len() / 16);
     for chunk in split_items(&lexed.tokens, text) {
         let offset = lexed.tokens[chunk.start].1.start;
         let end = lexed.tokens[chunk.end - 1].1.end;
@@ -158,8 +160,8 @@ pub fn parse_rules_with(
 /// or string, so lexing it alone gives the same tokens as in the file; the
 /// file's lexer has reported lexical errors already, so these are dropped.
 pub fn parse_item_text(text: &str, file: FileId) -> (Item, Vec<Diagnostic>) {
-    let lexed = lex(text, file);
-    parse_item(&lexed.tokens, text, 0, file)
+    let mut lexed = lex(text, file);
+    parse_item(&mut lexed.tokens, text, 0, file)
 }
 
 /// Moves a diagnostic's spans in `file` by `offset` (from item-relative to
@@ -423,8 +425,10 @@ fn rel_range(start: usize, end: usize) -> SimpleSpan {
     SimpleSpan::from(start..end)
 }
 
+/// Parses one item's tokens, which it takes out of `tokens` (a token
+/// passed on to the parser is moved, not copied).
 fn parse_item(
-    tokens: &[(Tok, Span)],
+    tokens: &mut [(Tok, Span)],
     text: &str,
     offset: u32,
     file: FileId,
@@ -438,12 +442,13 @@ fn parse_item(
     // Pre-pass: relative spans, PDDL groups read, nesting bounded.
     let mut input: Vec<(Tok, SimpleSpan)> = Vec::with_capacity(tokens.len());
     let is_condition = matches!(tokens.first(), Some((Tok::Ident(k), _)) if k == "condition");
-    let is_rule = matches!(tokens.first(), Some((Tok::Ident(k), _)) if k == "rule");
+    let is_rule = matches!(tokens.first(), Some((Tok::Ident(k), _)) if k == "rule")
+        && matches!(tokens.get(1), Some((Tok::Punct("("), _)));
     let mut nesting = Nesting::default();
     let mut i = 0;
     while i < tokens.len() {
         let (t, span) = &tokens[i];
-        if i == 2 && is_rule && matches!(tokens[1].0, Tok::Punct("(")) {
+        if i == 2 && is_rule {
             let (tok, next) = read_name_pattern(tokens, i, text, offset, file, &mut diags);
             if let Some(tok) = tok {
                 input.push(tok);
@@ -478,7 +483,9 @@ fn parse_item(
             );
             return (Item::Error { span: whole }, diags);
         }
-        input.push((t.clone(), rel(*span, offset)));
+        // Every look at the tokens (above) is at `i` or after it.
+        let span = rel(*span, offset);
+        input.push((std::mem::replace(&mut tokens[i].0, Tok::BadPddl), span));
         i += 1;
     }
     let eoi = SimpleSpan::from(whole.end as usize..whole.end as usize);
