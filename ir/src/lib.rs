@@ -61,7 +61,14 @@ impl PortValue {
 /// Floats always with a decimal point (`1.0`, not `1`).
 pub fn format_float(f: f64) -> String {
     if f.fract() == 0.0 && f.is_finite() && f.abs() < 1e15 {
-        format!("{f:.1}")
+        // As `{f:.1}` writes it, through integer formatting: `{:.1}` takes
+        // the exact (big-number) path, a tenth of a long plan's emit.
+        let sign = if f.is_sign_negative() && f == 0.0 {
+            "-"
+        } else {
+            ""
+        };
+        format!("{sign}{}.0", f as i64)
     } else {
         format!("{f}")
     }
@@ -445,5 +452,38 @@ fn count_of(param: &str, args: &[Port]) -> Option<Count> {
         PortValue::Text(t) => t.parse().ok().map(Count::Fixed),
         PortValue::Param(p) => Some(Count::Param { param: p.clone() }),
         _ => None,
+    }
+}
+
+#[cfg(test)]
+mod float_tests {
+    use super::format_float;
+
+    /// The integer path writes what `{:.1}` and `{}` would.
+    #[test]
+    fn floats_keep_their_text() {
+        for f in [
+            0.0f64,
+            -0.0,
+            1.0,
+            -1.0,
+            2.5,
+            1e14,
+            -1e14,
+            999_999_999_999_999.0,
+            1e15,
+            1e20,
+            0.1,
+            3.000_1,
+        ] {
+            let expected = if f.fract() == 0.0 && f.abs() < 1e15 {
+                format!("{f:.1}")
+            } else {
+                format!("{f}")
+            };
+            assert_eq!(format_float(f), expected, "{f}");
+        }
+        assert_eq!(format_float(-0.0), "-0.0");
+        assert_eq!(format_float(3.0), "3.0");
     }
 }
