@@ -788,7 +788,9 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
                 format!("`{id}` has children, but it is not a control or decorator node the runtime knows"),
             ));
         }
-        let what = format!("`{id}`");
+        // Only the KB leaves name themselves in their errors; a string per
+        // leaf was a fifth of loading a large tree.
+        let what = || format!("`{id}`");
         match id {
             "AlwaysSuccess" => return Ok(Op::AlwaysSuccess),
             "Script" | "ScriptCondition" => {
@@ -843,7 +845,7 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
             }
             "KbHolds" => {
                 let f = match self.kb_port(n, ports, "formula")? {
-                    PortValue::Formula(f) => self.e.kb_formula(Some(f), &what),
+                    PortValue::Formula(f) => self.e.kb_formula(Some(f), &what()),
                     other => Err(not_pddl(n, id, "formula", other, "condition")),
                 }
                 .map_err(|e| e.at_opt(n.at))?;
@@ -854,7 +856,7 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
             }
             "KbApply" => {
                 let e = match self.kb_port(n, ports, "effect")? {
-                    PortValue::Effect(e) => self.e.kb_effect(Some(e), &what),
+                    PortValue::Effect(e) => self.e.kb_effect(Some(e), &what()),
                     other => Err(not_pddl(n, id, "effect", other, "effect")),
                 }
                 .map_err(|e| e.at_opt(n.at))?;
