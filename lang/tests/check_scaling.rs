@@ -41,3 +41,39 @@ fn name_comparisons_grow_linearly() {
     // A handful per rule, not one per rule and action.
     assert!(c5000 <= 5 * 5000, "{c5000}");
 }
+
+/// Finding the actions a literal rule name names is a lookup: the index
+/// used to scan every action after the first of that name, which made a
+/// file of one rule per action quadratic (5,000 rules: 15x the time of
+/// 500) while the comparison count above stayed linear. The bound is
+/// loose: on this test's data 500 -> 5,000 costs 17-38x even when linear
+/// (the larger domain falls out of the caches); the scan cost 107-361x.
+#[test]
+fn literal_names_are_looked_up_not_scanned() {
+    use btc_lang::rules::actions::ActionIndex;
+    use btc_lang::rules::ast::NamePart;
+    use btc_lang::rules::name::Key;
+    use btc_pddl::source::Span;
+    btc_testkit::hostile::assert_linear(
+        "matching every action's own name",
+        500,
+        60.0,
+        |n| {
+            let text = btc_testkit::scale::domain(n);
+            let unit = btc_pddl::pipeline::domain_unit_from(&text, 0);
+            let domain = unit.domain.expect("the scale domain parses");
+            let index = ActionIndex::new(&domain);
+            (domain, index)
+        },
+        |(domain, index)| {
+            for a in &domain.actions {
+                let parts = [NamePart::Lit {
+                    text: a.name.name.clone(),
+                    key: Key::of_pddl(&a.name.name),
+                    span: Span::new(0, 0, 0),
+                }];
+                assert_eq!(index.matches(&parts, domain).len(), 1);
+            }
+        },
+    );
+}

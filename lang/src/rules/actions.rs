@@ -11,8 +11,9 @@ use rustc_hash::FxHashMap;
 
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct ActionIndex {
-    /// Action name to its index in `domain.actions` (the first, if repeated).
-    by_name: FxHashMap<String, usize>,
+    /// Action name to its indices in `domain.actions`, in domain order
+    /// (more than one only when the domain repeats a name).
+    by_name: FxHashMap<String, Vec<usize>>,
     /// (name, index), sorted by name.
     forwards: Vec<(String, usize)>,
     /// (name reversed, index), sorted by reversed name.
@@ -25,7 +26,10 @@ impl ActionIndex {
         let mut forwards = Vec::with_capacity(domain.actions.len());
         let mut backwards = Vec::with_capacity(domain.actions.len());
         for (i, a) in domain.actions.iter().enumerate() {
-            by_name.entry(a.name.name.clone()).or_insert(i);
+            by_name
+                .entry(a.name.name.clone())
+                .or_insert_with(Vec::new)
+                .push(i);
             forwards.push((a.name.name.clone(), i));
             backwards.push((a.name.name.chars().rev().collect(), i));
         }
@@ -43,13 +47,12 @@ impl ActionIndex {
     pub fn matches(&self, parts: &[NamePart], domain: &Domain) -> Vec<(usize, Captures)> {
         if let [NamePart::Lit { key, .. }] = parts {
             count_comparison();
-            return match self.by_name.get(key.as_str()) {
-                Some(&i) => (i..domain.actions.len())
-                    .filter(|&j| domain.actions[j].name.name == key.as_str())
-                    .map(|j| (j, Vec::new()))
-                    .collect(),
-                None => Vec::new(),
-            };
+            // The indices themselves: scanning the actions after the first
+            // made a file of one rule per action quadratic.
+            return self
+                .by_name
+                .get(key.as_str())
+                .map_or_else(Vec::new, |is| is.iter().map(|&j| (j, Vec::new())).collect());
         }
         let prefix = match parts.first() {
             Some(NamePart::Lit { key, .. }) => key.as_str(),
