@@ -12,8 +12,11 @@ use crate::task::test;
 
 pub struct LmCount<'g> {
     graph: &'g LandmarkGraph,
-    /// Each landmark's cost in the count.
+    /// Each landmark's cost in the count when it was not reached: the
+    /// cheapest of its possible first achievers.
     cost: Vec<u64>,
+    /// Its cost when it is needed again: the cheapest of all achievers.
+    again: Vec<u64>,
     words: usize,
 }
 
@@ -29,6 +32,11 @@ impl<'g> LmCount<'g> {
     pub fn new(graph: &'g LandmarkGraph, costs: Costs) -> LmCount<'g> {
         LmCount {
             cost: graph
+                .landmarks
+                .iter()
+                .map(|l| costs.of(l.first_cost))
+                .collect(),
+            again: graph
                 .landmarks
                 .iter()
                 .map(|l| costs.of(l.min_cost))
@@ -80,11 +88,12 @@ impl<'g> LmCount<'g> {
     pub fn value(&self, reached: &[u64], s: &[u64]) -> u64 {
         let mut h = 0;
         for (i, l) in self.graph.landmarks.iter().enumerate() {
-            let needed = !bit(reached, i)
-                || (!holds(l, s)
-                    && (l.goal || l.children.iter().any(|&c| !bit(reached, c as usize))));
-            if needed {
+            if !bit(reached, i) {
                 h += self.cost[i];
+            } else if !holds(l, s)
+                && (l.goal || l.children.iter().any(|&c| !bit(reached, c as usize)))
+            {
+                h += self.again[i];
             }
         }
         h
