@@ -42,7 +42,7 @@ pub struct Options {
 /// search's work): about a tenth of a second, see docs/planner.md. Enough
 /// for the restarts to match or beat lama-first's costs on the corpus and
 /// the held-out problems but barman/p02.
-pub const DEFAULT_IMPROVE: u64 = 10_000_000;
+pub const DEFAULT_IMPROVE: u64 = 30_000_000;
 
 impl Default for Options {
     fn default() -> Self {
