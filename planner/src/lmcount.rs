@@ -5,6 +5,14 @@
 //! reached when it holds and every landmark ordered before it was reached
 //! in the state before. A reached landmark is needed again when it does not
 //! hold and it is a goal, or a landmark ordered after it is not reached.
+//!
+//! A landmark not reached counts the cheapest of its possible first
+//! achievers (those the landmark generation found can make it true before
+//! it ever was), one needed again the cheapest of all its achievers, as
+//! Fast Downward's `landmark_sum` does: on tasks with costs a cheap
+//! achiever that needs the landmark itself (pouring an ingredient back
+//! from a shaker that needs it poured in first) does not hide the cost of
+//! the only way to make it true the first time.
 
 use crate::heuristic::Costs;
 use crate::landmarks::{Landmark, LandmarkGraph};
