@@ -42,6 +42,10 @@ pub struct Landmark {
     pub children: Vec<u32>,
     /// The cheapest cost of an achiever (0 for derived facts).
     pub min_cost: u64,
+    /// The cheapest cost of a possible first achiever (one that can make
+    /// the landmark true before it ever was); `min_cost` when they are not
+    /// known (landmarks true initially).
+    pub first_cost: u64,
 }
 
 #[derive(Clone, Debug, Default)]
@@ -237,6 +241,7 @@ impl LandmarkGraph {
                 parents: Vec::new(),
                 children: Vec::new(),
                 min_cost: 0,
+                first_cost: u64::MAX,
             });
             removed.push(false);
             queue.push_back(id);
@@ -250,6 +255,11 @@ impl LandmarkGraph {
             if first.is_empty() {
                 continue;
             }
+            graph.landmarks[id as usize].first_cost = first
+                .iter()
+                .map(|&u| gen.unary[u as usize].cost)
+                .min()
+                .unwrap_or(u64::MAX);
             // Conditions every possible first achiever has.
             let mut shared: Vec<u32> = gen.unary[first[0] as usize].pre.clone();
             for &u in &first[1..] {
@@ -318,6 +328,7 @@ impl LandmarkGraph {
                             parents: Vec::new(),
                             children: Vec::new(),
                             min_cost: 0,
+                            first_cost: u64::MAX,
                         });
                         removed.push(false);
                         queue.push_back(p);
@@ -368,6 +379,9 @@ impl LandmarkGraph {
                 .map(|&u| gen.unary[u as usize].cost)
                 .min()
                 .unwrap_or(0);
+            if l.first_cost == u64::MAX {
+                l.first_cost = l.min_cost;
+            }
             for &f in &l.facts {
                 self.by_fact[f as usize].push(i as u32);
             }

@@ -230,8 +230,9 @@ fn lm_cut_lies_between_h_max_and_the_optimal_cost() {
 /// LAMA's restarts: the same plan on every run (the budget is work, not
 /// time), never costlier than the first plan, and on problems where the
 /// first greedy plan is poor they find the cheaper one (blocks/p01: the
-/// greedy 10 steps against the optimal 6; barman/p01: 113 against 102, the
-/// cost lama-first finds).
+/// greedy 10 steps against the optimal 6; barman/p01 and p02: 113 and 110
+/// against 102 and 104, the costs lama-first finds; both reach 94 with
+/// landmarks costed by their first achievers).
 #[test]
 fn lama_restarts_are_deterministic_and_only_make_plans_cheaper() {
     if btc_testkit::corpus().is_none() {
@@ -241,6 +242,7 @@ fn lama_restarts_are_deterministic_and_only_make_plans_cheaper() {
         ("blocks", "p01", 6.0),
         ("floortile", "p01", 38.0),
         ("barman", "p01", 102.0),
+        ("barman", "p02", 104.0),
         ("elevators", "p01", 42.0),
     ] {
         let (d, p) = corpus_case(domain, problem);
