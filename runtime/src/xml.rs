@@ -45,13 +45,22 @@ fn offset_in(e: &BytesStart, part: &[u8], at: usize) -> usize {
     }
 }
 
+/// A name the reader sliced out of the `&str` it reads, so UTF-8 (the
+/// lossy decoder is the fallback, and walked every name byte by byte).
+fn text_of(bytes: &[u8]) -> String {
+    match std::str::from_utf8(bytes) {
+        Ok(s) => s.to_owned(),
+        Err(_) => String::from_utf8_lossy(bytes).into_owned(),
+    }
+}
+
 fn elem(e: &BytesStart, r: &Reader<&[u8]>, at: usize) -> Result<Elem, LoadError> {
-    let name = String::from_utf8_lossy(e.name().as_ref()).into_owned();
+    let name = text_of(e.name().as_ref());
     let mut attrs = Vec::new();
     let mut attr_at = Vec::new();
     for a in e.attributes() {
         let a = a.map_err(|err| syntax(format!("a bad attribute in <{name}>: {err}"), at))?;
-        let key = String::from_utf8_lossy(a.key.as_ref()).into_owned();
+        let key = text_of(a.key.as_ref());
         attr_at.push((key.clone(), offset_in(e, a.key.as_ref(), at)));
         let value = a
             .decode_and_unescape_value(r.decoder())
