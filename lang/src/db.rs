@@ -286,8 +286,9 @@ pub struct ItemText<'db> {
 
 /// One item parsed, with spans relative to its start.
 #[salsa::tracked(returns(ref))]
-pub fn parsed_item<'db>(db: &'db dyn Db, item: ItemText<'db>) -> (Item, Vec<Diagnostic>) {
-    parse_item_text(item.text(db), file_id(db, item.file(db)))
+pub fn parsed_item<'db>(db: &'db dyn Db, item: ItemText<'db>) -> (Arc<Item>, Vec<Diagnostic>) {
+    let (item, diagnostics) = parse_item_text(item.text(db), file_id(db, item.file(db)));
+    (Arc::new(item), diagnostics)
 }
 
 /// One top-level item. Identified by its file and head (kind and name or
@@ -393,7 +394,7 @@ pub fn declared_path(db: &dyn Db, file: SourceFile, problem: bool) -> Option<(St
     parsed_rules(db, file)
         .items
         .iter()
-        .find_map(|n| match &n.item {
+        .find_map(|n| match &*n.item {
             Item::Domain { path, span } if !problem => path.plain().map(|p| (p, *span, n.offset)),
             Item::Problem { path, span } if problem => path.plain().map(|p| (p, *span, n.offset)),
             _ => None,
@@ -474,7 +475,7 @@ pub fn import_closure(db: &dyn Db, file: SourceFile) -> (Vec<SourceFile>, Vec<Di
         let f = order[i];
         i += 1;
         for n in &parsed_rules(db, f).items {
-            let Item::Import { target, span } = &n.item else {
+            let Item::Import { target, span } = &*n.item else {
                 continue;
             };
             let found = match target {
@@ -956,7 +957,7 @@ pub fn compile(db: &dyn Db, job: CompileJob) -> Result<btc_ir::TreeIr, Vec<Diagn
     let mut plan_template = None;
     for f in &import_closure(db, rules).0 {
         for n in &parsed_rules(db, *f).items {
-            match &n.item {
+            match &*n.item {
                 Item::Rule(r) => all_rules.push(r),
                 Item::Plan { body, .. } if *f == rules && plan_template.is_none() => {
                     plan_template = Some(body.as_slice())

@@ -91,7 +91,7 @@ impl<'a> Analysis<'a> {
 
     /// The rule of item `item`, if it is one.
     pub fn rule(&self, item: usize) -> Option<&'a Rule> {
-        match &self.items.get(item)?.item {
+        match &*self.items.get(item)?.item {
             Item::Rule(r) => Some(r),
             _ => None,
         }

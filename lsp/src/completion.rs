@@ -123,7 +123,7 @@ pub fn context(a: &Analysis, offset: usize) -> Context {
         }
     }
     if depth > 0 {
-        let is_table = matches!(a.items[item].item, Item::Table(_))
+        let is_table = matches!(*a.items[item].item, Item::Table(_))
             || t.ident(t.after(start)) == Some("table");
         return if is_table {
             Context::Nothing
@@ -165,7 +165,7 @@ fn variables(a: &Analysis, offset: usize) -> Vec<CompletionItem> {
     let Some(ix) = a.syntax.item_at(offset as u32) else {
         return Vec::new();
     };
-    match &a.items[ix].item {
+    match &*a.items[ix].item {
         Item::Rule(r) => r
             .pattern
             .params

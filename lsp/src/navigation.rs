@@ -48,7 +48,7 @@ pub fn hover(a: &Analysis, offset: usize) -> Option<Hover> {
                 .collect::<Option<Vec<_>>>()?
                 .join("\n\n")
         }
-        Target::Var { name, .. } => match &a.items[item].item {
+        Target::Var { name, .. } => match &*a.items[item].item {
             Item::Rule(r) => {
                 let types = a.var_types(item, name);
                 match r.pattern.params.iter().position(|p| p.var.text == *name) {
@@ -216,7 +216,7 @@ fn keyword_hover(a: &Analysis, offset: usize) -> Option<Hover> {
         return None;
     }
     let item = a.syntax.item_at(t.toks[i].1.start)?;
-    if !matches!(a.items[item].item, Item::Rule(_) | Item::Tree(_)) {
+    if !matches!(*a.items[item].item, Item::Rule(_) | Item::Tree(_)) {
         return None;
     }
     let mut text = format!(

@@ -21,7 +21,7 @@ pub fn item_symbols(a: &Analysis) -> Vec<ItemSymbol> {
     for n in a.items {
         let o = n.offset;
         let whole = shift(n.item.span(), o);
-        let (name, detail, kind, name_span) = match &n.item {
+        let (name, detail, kind, name_span) = match &*n.item {
             Item::Domain { path, span } => (
                 format!("domain {}", path.plain().unwrap_or_default()),
                 None,

@@ -125,7 +125,10 @@ pub struct ParsedRules {
 }
 
 pub fn parse_rules(text: &str, file: FileId) -> ParsedRules {
-    parse_rules_with(text, file, |item| parse_item_text(item, file))
+    parse_rules_with(text, file, |item| {
+        let (item, diagnostics) = parse_item_text(item, file);
+        (std::sync::Arc::new(item), diagnostics)
+    })
 }
 
 /// [`parse_rules`] with each item's text parsed by `parse_item`, which the
@@ -134,7 +137,7 @@ pub fn parse_rules(text: &str, file: FileId) -> ParsedRules {
 pub fn parse_rules_with(
     text: &str,
     file: FileId,
-    mut parse_item: impl FnMut(&str) -> (Item, Vec<Diagnostic>),
+    mut parse_item: impl FnMut(&str) -> (std::sync::Arc<Item>, Vec<Diagnostic>),
 ) -> ParsedRules {
     // Cutting needs only the item keywords' names: the other tokens'
     // names are left unallocated (each item is lexed again to parse it).
@@ -1159,7 +1162,7 @@ mod tests {
             assert!(p
                 .items
                 .iter()
-                .all(|i| !matches!(i.item, Item::Error { .. })));
+                .all(|i| !matches!(*i.item, Item::Error { .. })));
         }
     }
 
@@ -1167,7 +1170,7 @@ mod tests {
     fn reads_patterns_guards_and_effects() {
         let p = parse("rule (PICK_{op} ?a [?loc]) where op in markers, ?a != ?loc {\n  Pick(agent: ?A, marker: markers[op])\n  effect (and (holding ?a) (not (free ?a)))\n}");
         assert!(p.diagnostics.is_empty(), "{:#?}", p.diagnostics);
-        let Item::Rule(r) = &p.items[0].item else {
+        let Item::Rule(r) = &*p.items[0].item else {
             panic!()
         };
         assert_eq!(r.pattern.name_text(), "PICK_{op}");
@@ -1188,7 +1191,7 @@ mod tests {
     fn spans_are_relative_to_their_item() {
         let p = parse("action A()\n\naction B(x: int)");
         assert_eq!(p.items[1].offset, 12);
-        let Item::Node(n) = &p.items[1].item else {
+        let Item::Node(n) = &*p.items[1].item else {
             panic!()
         };
         assert_eq!(n.name.span, Span::new(0, 7, 8));
@@ -1200,7 +1203,7 @@ mod tests {
         let p = parse(text);
         assert_eq!(codes(&p).len(), 2, "{:#?}", p.diagnostics);
         assert_eq!(p.items.len(), 3);
-        assert!(matches!(p.items[2].item, Item::Node(_)));
+        assert!(matches!(*p.items[2].item, Item::Node(_)));
     }
 
     #[test]
@@ -1210,14 +1213,14 @@ mod tests {
         let p = parse(text);
         assert_eq!(p.items.len(), 2);
         assert_eq!(p.diagnostics.len(), 1, "{:#?}", p.diagnostics);
-        assert!(matches!(p.items[1].item, Item::Rule(_)));
+        assert!(matches!(*p.items[1].item, Item::Rule(_)));
     }
 
     #[test]
     fn interpolation_and_escapes() {
         let p = parse("tree T() { sequence \"move {?Robot} to {op} \\{x\\}\" { } }");
         assert!(p.diagnostics.is_empty(), "{:#?}", p.diagnostics);
-        let Item::Tree(t) = &p.items[0].item else {
+        let Item::Tree(t) = &*p.items[0].item else {
             panic!()
         };
         let Template::Control { name: Some(s), .. } = &t.body[0] else {
@@ -1233,7 +1236,7 @@ mod tests {
         let src = r#"tree T() { sequence "a\"b\\c\n{?x}d" { } }"#;
         let p = parse(src);
         assert!(p.diagnostics.is_empty(), "{:#?}", p.diagnostics);
-        let Item::Tree(t) = &p.items[0].item else {
+        let Item::Tree(t) = &*p.items[0].item else {
             panic!()
         };
         let Template::Control { name: Some(s), .. } = &t.body[0] else {
