@@ -787,6 +787,38 @@ pub(crate) mod tests {
         }
     }
 
+    /// A file's items are its items' parses, not copies of them (copying
+    /// every item of a huge file on each edit was a large part of the
+    /// edit's time): before and after an edit, each item of the parsed
+    /// file is the allocation its `parsed_item` memo holds.
+    #[test]
+    fn the_parsed_file_shares_its_items_with_their_parses() {
+        let mut db = Database::new();
+        load(&mut db, "examples/ariac/domain.pddl");
+        let f = load(&mut db, "lang/tests/fixtures/large.btrules");
+        let shared = |db: &Database| {
+            let parsed = parsed_file(db, f);
+            assert!(parsed.rules.items.len() > 700);
+            for (n, t) in parsed.rules.items.iter().zip(&parsed.texts) {
+                let t = t.expect("a rules file's items have texts");
+                assert!(Arc::ptr_eq(&n.item, &parsed_item(db, t).0));
+            }
+            for i in rules_items(db, f) {
+                let ItemSource::Text(t) = i.source(db) else {
+                    panic!("not a palette")
+                };
+                assert!(std::ptr::eq(i.item(db), &*parsed_item(db, t).0));
+            }
+        };
+        shared(&db);
+        let first = parsed_rules(&db, f).items[5].item.clone();
+        let text = format!("// a comment first\n{}", f.text(&db));
+        db.set_file(&f.path(&db).clone(), text);
+        shared(&db);
+        // The items the edit left alone are the same allocations as before.
+        assert!(Arc::ptr_eq(&first, &parsed_rules(&db, f).items[5].item));
+    }
+
     #[test]
     fn editing_one_rule_rechecks_only_that_rule() {
         let mut db = Database::new();

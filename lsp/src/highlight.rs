@@ -67,8 +67,8 @@ pub fn classified(a: &Analysis) -> Vec<(Span, SemanticTokenType)> {
     names.sort_by_key(|(start, _)| *start);
     names.dedup_by_key(|(start, _)| *start);
     let mut next = names.iter().peekable();
-    let mut out = Vec::with_capacity(a.syntax.tokens.toks.len());
-    for (tok, span) in a.syntax.tokens.toks {
+    let mut out = Vec::with_capacity(a.syntax.tokens().toks.len());
+    for (tok, span) in a.syntax.tokens().toks {
         let ty = match tok {
             Tok::Str(_) => Some(SemanticTokenType::STRING),
             Tok::Int(_) | Tok::Float(_) => Some(SemanticTokenType::NUMBER),
@@ -85,7 +85,7 @@ pub fn classified(a: &Analysis) -> Vec<(Span, SemanticTokenType)> {
             out.push((*span, t));
         }
     }
-    for c in a.syntax.tokens.comments {
+    for c in a.syntax.tokens().comments {
         out.push((c.span, SemanticTokenType::COMMENT));
     }
     out.sort_by_key(|(s, _)| s.start);

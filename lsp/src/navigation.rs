@@ -209,7 +209,7 @@ pub fn hover(a: &Analysis, offset: usize) -> Option<Hover> {
 /// template's keyword: not a port name (`delay: 3`), not in a call's
 /// parentheses or a PDDL formula.
 fn keyword_hover(a: &Analysis, offset: usize) -> Option<Hover> {
-    let t = &a.syntax.tokens;
+    let t = &a.syntax.tokens();
     let i = t.at(offset)?;
     let spec = btc_ir::NodeSpec::by_keyword(t.ident(i)?)?;
     if t.punct(i + 1) == Some(":") || t.open_paren(i).is_some() || t.in_pddl(i) {

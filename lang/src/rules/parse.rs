@@ -4,7 +4,7 @@
 //! becomes [`Item::Error`] and the others still parse.
 
 use super::ast::*;
-use super::lexer::{lex, lex_for_cutting, Comment, Tok};
+use super::lexer::{lex, lex_each, Comment, Tok};
 use btc_ir::vocab::{Arity, ControlName, NodeSpec};
 use btc_pddl::diagnostic::{codes, Diagnostic};
 use btc_pddl::lexer::{Tok as PTok, Token as PToken};
@@ -140,13 +140,19 @@ pub fn parse_rules_with(
     mut parse_item: impl FnMut(&str) -> (std::sync::Arc<Item>, Vec<Diagnostic>),
 ) -> ParsedRules {
     // Cutting needs only the item keywords' names: the other tokens'
-    // names are left unallocated (each item is lexed again to parse it).
-    let lexed = lex_for_cutting(text, file, &|w| ITEM_KEYWORDS.contains(&w));
+    // names are left unallocated, and the tokens are not kept (each item
+    // is lexed again to parse it).
+    let mut cut = Cutter::new(text);
+    let lexed = lex_each(
+        text,
+        file,
+        &|w| ITEM_KEYWORDS.contains(&w),
+        &mut |t, span| cut.token(&t, span),
+    );
     let mut diagnostics = lexed.diagnostics;
-    let mut items = Vec::with_capacity(lexed.tokens.len() / 16);
-    for chunk in split_items(&lexed.tokens, text) {
-        let offset = lexed.tokens[chunk.start].1.start;
-        let end = lexed.tokens[chunk.end - 1].1.end;
+    let chunks = cut.finish();
+    let mut items = Vec::with_capacity(chunks.len());
+    for (offset, end) in chunks {
         let (item, diags) = parse_item(&text[offset as usize..end as usize]);
         diagnostics.extend(diags.into_iter().map(|d| shift(d, file, offset)));
         items.push(ItemNode { offset, item });
@@ -190,32 +196,50 @@ fn at_line_start(text: &str, offset: u32) -> bool {
     offset == 0 || text.as_bytes().get(offset as usize - 1) == Some(&b'\n')
 }
 
-fn split_items(tokens: &[(Tok, Span)], text: &str) -> Vec<std::ops::Range<usize>> {
-    let mut out = Vec::new();
-    let mut depth = 0usize;
-    let mut start = None;
-    for (i, (t, span)) in tokens.iter().enumerate() {
+/// Cuts a file into items as its tokens come: an item starts at an item
+/// keyword outside brackets or at the start of a line, and runs from its
+/// first token's start to its last token's end.
+struct Cutter<'t> {
+    text: &'t str,
+    depth: usize,
+    /// The current item's start, and the end of its last token so far.
+    current: Option<(u32, u32)>,
+    items: Vec<(u32, u32)>,
+}
+
+impl<'t> Cutter<'t> {
+    fn new(text: &'t str) -> Cutter<'t> {
+        Cutter {
+            text,
+            depth: 0,
+            current: None,
+            items: Vec::new(),
+        }
+    }
+
+    fn token(&mut self, t: &Tok, span: Span) {
         let is_kw = matches!(t, Tok::Ident(k) if ITEM_KEYWORDS.contains(&k.as_str()));
-        if is_kw && (depth == 0 || at_line_start(text, span.start)) {
-            if let Some(s) = start {
-                out.push(s..i);
+        if is_kw && (self.depth == 0 || at_line_start(self.text, span.start)) {
+            if let Some(item) = self.current.take() {
+                self.items.push(item);
             }
-            start = Some(i);
-            depth = 0;
+            self.depth = 0;
         }
-        if start.is_none() {
-            start = Some(i); // text before the first keyword is an item of its own (an error)
-        }
+        // Text before the first keyword is an item of its own (an error).
+        let item = self.current.get_or_insert((span.start, span.end));
+        item.1 = span.end;
         match t {
-            Tok::Punct("(" | "{" | "[") => depth += 1,
-            Tok::Punct(")" | "}" | "]") => depth = depth.saturating_sub(1),
+            Tok::Punct("(" | "{" | "[") => self.depth += 1,
+            Tok::Punct(")" | "}" | "]") => self.depth = self.depth.saturating_sub(1),
             _ => {}
         }
     }
-    if let Some(s) = start {
-        out.push(s..tokens.len());
+
+    /// Each item's start and end.
+    fn finish(mut self) -> Vec<(u32, u32)> {
+        self.items.extend(self.current);
+        self.items
     }
-    out
 }
 
 fn rel(span: Span, offset: u32) -> SimpleSpan {
