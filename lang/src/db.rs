@@ -286,8 +286,9 @@ pub struct ItemText<'db> {
 
 /// One item parsed, with spans relative to its start.
 #[salsa::tracked(returns(ref))]
-pub fn parsed_item<'db>(db: &'db dyn Db, item: ItemText<'db>) -> (Item, Vec<Diagnostic>) {
-    parse_item_text(item.text(db), file_id(db, item.file(db)))
+pub fn parsed_item<'db>(db: &'db dyn Db, item: ItemText<'db>) -> (Arc<Item>, Vec<Diagnostic>) {
+    let (item, diagnostics) = parse_item_text(item.text(db), file_id(db, item.file(db)));
+    (Arc::new(item), diagnostics)
 }
 
 /// One top-level item. Identified by its file and head (kind and name or
@@ -393,7 +394,7 @@ pub fn declared_path(db: &dyn Db, file: SourceFile, problem: bool) -> Option<(St
     parsed_rules(db, file)
         .items
         .iter()
-        .find_map(|n| match &n.item {
+        .find_map(|n| match &*n.item {
             Item::Domain { path, span } if !problem => path.plain().map(|p| (p, *span, n.offset)),
             Item::Problem { path, span } if problem => path.plain().map(|p| (p, *span, n.offset)),
             _ => None,
@@ -474,7 +475,7 @@ pub fn import_closure(db: &dyn Db, file: SourceFile) -> (Vec<SourceFile>, Vec<Di
         let f = order[i];
         i += 1;
         for n in &parsed_rules(db, f).items {
-            let Item::Import { target, span } = &n.item else {
+            let Item::Import { target, span } = &*n.item else {
                 continue;
             };
             let found = match target {
@@ -786,6 +787,38 @@ pub(crate) mod tests {
         }
     }
 
+    /// A file's items are its items' parses, not copies of them (copying
+    /// every item of a huge file on each edit was a large part of the
+    /// edit's time): before and after an edit, each item of the parsed
+    /// file is the allocation its `parsed_item` memo holds.
+    #[test]
+    fn the_parsed_file_shares_its_items_with_their_parses() {
+        let mut db = Database::new();
+        load(&mut db, "examples/ariac/domain.pddl");
+        let f = load(&mut db, "lang/tests/fixtures/large.btrules");
+        let shared = |db: &Database| {
+            let parsed = parsed_file(db, f);
+            assert!(parsed.rules.items.len() > 700);
+            for (n, t) in parsed.rules.items.iter().zip(&parsed.texts) {
+                let t = t.expect("a rules file's items have texts");
+                assert!(Arc::ptr_eq(&n.item, &parsed_item(db, t).0));
+            }
+            for i in rules_items(db, f) {
+                let ItemSource::Text(t) = i.source(db) else {
+                    panic!("not a palette")
+                };
+                assert!(std::ptr::eq(i.item(db), &*parsed_item(db, t).0));
+            }
+        };
+        shared(&db);
+        let first = parsed_rules(&db, f).items[5].item.clone();
+        let text = format!("// a comment first\n{}", f.text(&db));
+        db.set_file(&f.path(&db).clone(), text);
+        shared(&db);
+        // The items the edit left alone are the same allocations as before.
+        assert!(Arc::ptr_eq(&first, &parsed_rules(&db, f).items[5].item));
+    }
+
     #[test]
     fn editing_one_rule_rechecks_only_that_rule() {
         let mut db = Database::new();
@@ -956,7 +989,7 @@ pub fn compile(db: &dyn Db, job: CompileJob) -> Result<btc_ir::TreeIr, Vec<Diagn
     let mut plan_template = None;
     for f in &import_closure(db, rules).0 {
         for n in &parsed_rules(db, *f).items {
-            match &n.item {
+            match &*n.item {
                 Item::Rule(r) => all_rules.push(r),
                 Item::Plan { body, .. } if *f == rules && plan_template.is_none() => {
                     plan_template = Some(body.as_slice())

@@ -30,7 +30,7 @@ pub fn declared_nodes(db: &dyn Db, file: SourceFile) -> Vec<DeclaredNode> {
         };
         let fid = file_id(db, f);
         for n in &parsed_rules(db, f).items {
-            let Item::Node(decl) = &n.item else { continue };
+            let Item::Node(decl) = &*n.item else { continue };
             if out.iter().any(|d| d.model.id == decl.name.text) {
                 continue;
             }

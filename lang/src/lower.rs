@@ -1073,8 +1073,11 @@ pub fn node_model(id: &str, n: &NodeDecl) -> NodeModel {
 /// The `std::kb` declarations btc itself emits, available without import.
 fn kb_decl(id: &str) -> Option<NodeDecl> {
     let parsed = crate::rules::parse_rules(include_str!("../../stdlib/kb.btrules"), 0);
-    parsed.items.into_iter().find_map(|i| match i.item {
-        Item::Node(n) if n.name.text == id => Some(n),
-        _ => None,
-    })
+    parsed
+        .items
+        .into_iter()
+        .find_map(|i| match std::sync::Arc::unwrap_or_clone(i.item) {
+            Item::Node(n) if n.name.text == id => Some(n),
+            _ => None,
+        })
 }

@@ -15,7 +15,15 @@ fn parts(pattern: &str) -> Vec<NamePart> {
         "{pattern}: {:#?}",
         parsed.diagnostics
     );
-    match parsed.items.into_iter().next().unwrap().item {
+    match parsed
+        .items
+        .into_iter()
+        .next()
+        .unwrap()
+        .item
+        .as_ref()
+        .clone()
+    {
         Item::Rule(r) => r.pattern.name,
         other => panic!("{pattern}: {other:?}"),
     }

@@ -3,7 +3,6 @@
 
 use crate::convert::LineIndex;
 use crate::syntax::FileSyntax;
-use crate::syntax::Tokens;
 use crate::workspace::Workspace;
 use btc_lang::db::{
     action_index, checked_domain, declarations, parsed_rules, rule_var_types, rules_items,
@@ -61,8 +60,10 @@ impl<'a> Analysis<'a> {
             domain,
             syntax: FileSyntax {
                 text,
-                tokens: Tokens::of(btc_lang::db::rules_tokens(db, file)),
                 items,
+                db,
+                file,
+                tokens: std::cell::OnceCell::new(),
             },
             lines: std::cell::OnceCell::new(),
         })
@@ -91,7 +92,7 @@ impl<'a> Analysis<'a> {
 
     /// The rule of item `item`, if it is one.
     pub fn rule(&self, item: usize) -> Option<&'a Rule> {
-        match &self.items.get(item)?.item {
+        match &*self.items.get(item)?.item {
             Item::Rule(r) => Some(r),
             _ => None,
         }

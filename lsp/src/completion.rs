@@ -39,8 +39,8 @@ struct Cursor {
 }
 
 fn cursor(a: &Analysis, offset: usize) -> Cursor {
-    let toks = &a.syntax.tokens.toks;
-    let i = a.syntax.tokens.after(offset);
+    let toks = &a.syntax.tokens().toks;
+    let i = a.syntax.tokens().after(offset);
     // The token that ends at or contains the cursor.
     let prefix = i.checked_sub(1).filter(|&j| {
         let (t, s) = &toks[j];
@@ -59,7 +59,7 @@ fn cursor(a: &Analysis, offset: usize) -> Cursor {
 }
 
 pub fn context(a: &Analysis, offset: usize) -> Context {
-    let t = &a.syntax.tokens;
+    let t = &a.syntax.tokens();
     let c = cursor(a, offset);
     let before = a.text.get(..offset).unwrap_or_default();
     if matches!(c.prefix.map(|p| &t.toks[p].0), Some(Tok::Var(_))) || before.ends_with('?') {
@@ -123,7 +123,7 @@ pub fn context(a: &Analysis, offset: usize) -> Context {
         }
     }
     if depth > 0 {
-        let is_table = matches!(a.items[item].item, Item::Table(_))
+        let is_table = matches!(*a.items[item].item, Item::Table(_))
             || t.ident(t.after(start)) == Some("table");
         return if is_table {
             Context::Nothing
@@ -165,7 +165,7 @@ fn variables(a: &Analysis, offset: usize) -> Vec<CompletionItem> {
     let Some(ix) = a.syntax.item_at(offset as u32) else {
         return Vec::new();
     };
-    match &a.items[ix].item {
+    match &*a.items[ix].item {
         Item::Rule(r) => r
             .pattern
             .params
@@ -194,7 +194,7 @@ fn variables(a: &Analysis, offset: usize) -> Vec<CompletionItem> {
             // The item does not parse yet: the variables of its pattern.
             let start = a.items[ix].offset;
             a.syntax
-                .tokens
+                .tokens()
                 .toks
                 .iter()
                 .filter(|(_, s)| s.start >= start && (s.end as usize) < offset)
@@ -222,7 +222,7 @@ pub fn completion(a: &Analysis, offset: usize) -> Vec<CompletionItem> {
             out = variables(a, offset);
             // Replace the whole `?name` typed so far: clients that do not
             // count `?` as part of a word would otherwise insert `??name`.
-            let t = &a.syntax.tokens;
+            let t = &a.syntax.tokens();
             let c = cursor(a, offset);
             let start = match c.prefix.map(|p| &t.toks[p]) {
                 Some((Tok::Var(_), s)) => s.start as usize,
@@ -367,7 +367,7 @@ fn call_item(name: &str, ports: &[PortDecl], kind: CompletionItemKind) -> Comple
 
 /// Signature help inside a node or tree call's parentheses.
 pub fn signature_help(a: &Analysis, offset: usize) -> Option<SignatureHelp> {
-    let t = &a.syntax.tokens;
+    let t = &a.syntax.tokens();
     let here = t.after(offset);
     let (node, decl) = t.enclosing_call(here)?;
     if decl {

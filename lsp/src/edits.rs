@@ -103,7 +103,7 @@ pub fn rule_stubs(a: &Analysis) -> Option<String> {
     let mut patterns = Vec::new();
     for f in import_closure(&a.ws.db, a.file).0.iter() {
         for n in &parsed_rules(&a.ws.db, *f).items {
-            if let Item::Rule(r) = &n.item {
+            if let Item::Rule(r) = &*n.item {
                 patterns.push(&r.pattern.name);
             }
         }

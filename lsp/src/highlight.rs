@@ -6,7 +6,6 @@ use btc_lang::rules::ast::Item;
 use btc_lang::rules::lexer::Tok;
 use btc_lang::rules::resolve::Target;
 use btc_pddl::source::Span;
-use std::collections::HashMap;
 use tower_lsp::lsp_types::{
     InlayHint, InlayHintKind, InlayHintLabel, Range, SemanticToken, SemanticTokenType,
     SemanticTokensLegend,
@@ -58,31 +57,35 @@ fn of_target(t: &Target) -> SemanticTokenType {
 /// them, keywords, literals and comments from the tokens (so a file that
 /// does not parse still shows its keywords and strings).
 pub fn classified(a: &Analysis) -> Vec<(Span, SemanticTokenType)> {
-    let mut names: HashMap<u32, SemanticTokenType> = HashMap::new();
+    // The resolved names by position (the first resolution of a position
+    // wins), read alongside the tokens, which come in the same order: a
+    // huge file has hundreds of thousands of both.
+    let mut names: Vec<(u32, &Target)> = Vec::new();
     for k in 0..a.items.len() {
-        for (span, r) in a.names_of(k) {
-            names
-                .entry(span.start)
-                .or_insert_with(|| of_target(&r.target));
-        }
+        names.extend(a.names_of(k).map(|(span, r)| (span.start, &r.target)));
     }
-    let mut out = Vec::new();
-    for (tok, span) in a.syntax.tokens.toks {
+    names.sort_by_key(|(start, _)| *start);
+    names.dedup_by_key(|(start, _)| *start);
+    let mut next = names.iter().peekable();
+    let mut out = Vec::with_capacity(a.syntax.tokens().toks.len());
+    for (tok, span) in a.syntax.tokens().toks {
         let ty = match tok {
             Tok::Str(_) => Some(SemanticTokenType::STRING),
             Tok::Int(_) | Tok::Float(_) => Some(SemanticTokenType::NUMBER),
             Tok::Var(_) => Some(SemanticTokenType::PARAMETER),
-            Tok::Ident(word) => names
-                .get(&span.start)
-                .cloned()
-                .or_else(|| is_keyword(word).then_some(SemanticTokenType::KEYWORD)),
+            Tok::Ident(word) => {
+                while next.next_if(|(start, _)| *start < span.start).is_some() {}
+                next.next_if(|(start, _)| *start == span.start)
+                    .map(|(_, target)| of_target(target))
+                    .or_else(|| is_keyword(word).then_some(SemanticTokenType::KEYWORD))
+            }
             _ => None,
         };
         if let Some(t) = ty {
             out.push((*span, t));
         }
     }
-    for c in a.syntax.tokens.comments {
+    for c in a.syntax.tokens().comments {
         out.push((c.span, SemanticTokenType::COMMENT));
     }
     out.sort_by_key(|(s, _)| s.start);
@@ -134,7 +137,7 @@ pub fn inlay_hints(a: &Analysis, range: Range) -> Vec<InlayHint> {
     let (from, to) = (ix.offset(range.start) as u32, ix.offset(range.end) as u32);
     let mut out = Vec::new();
     for (k, n) in a.items.iter().enumerate() {
-        let Item::Rule(r) = &n.item else { continue };
+        let Item::Rule(r) = &*n.item else { continue };
         let whole = shift(r.span, n.offset);
         if whole.end < from || whole.start > to {
             continue;

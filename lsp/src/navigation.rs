@@ -48,7 +48,7 @@ pub fn hover(a: &Analysis, offset: usize) -> Option<Hover> {
                 .collect::<Option<Vec<_>>>()?
                 .join("\n\n")
         }
-        Target::Var { name, .. } => match &a.items[item].item {
+        Target::Var { name, .. } => match &*a.items[item].item {
             Item::Rule(r) => {
                 let types = a.var_types(item, name);
                 match r.pattern.params.iter().position(|p| p.var.text == *name) {
@@ -209,14 +209,14 @@ pub fn hover(a: &Analysis, offset: usize) -> Option<Hover> {
 /// template's keyword: not a port name (`delay: 3`), not in a call's
 /// parentheses or a PDDL formula.
 fn keyword_hover(a: &Analysis, offset: usize) -> Option<Hover> {
-    let t = &a.syntax.tokens;
+    let t = &a.syntax.tokens();
     let i = t.at(offset)?;
     let spec = btc_ir::NodeSpec::by_keyword(t.ident(i)?)?;
     if t.punct(i + 1) == Some(":") || t.open_paren(i).is_some() || t.in_pddl(i) {
         return None;
     }
     let item = a.syntax.item_at(t.toks[i].1.start)?;
-    if !matches!(a.items[item].item, Item::Rule(_) | Item::Tree(_)) {
+    if !matches!(*a.items[item].item, Item::Rule(_) | Item::Tree(_)) {
         return None;
     }
     let mut text = format!(

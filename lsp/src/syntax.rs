@@ -154,11 +154,22 @@ pub fn is_keyword(word: &str) -> bool {
 /// A file's tokens with its parsed items.
 pub struct FileSyntax<'a> {
     pub text: &'a str,
-    pub tokens: Tokens<'a>,
     pub items: &'a [ItemNode],
+    /// Where the tokens come from, read when a request first needs them
+    /// (symbols and hovers do not: lexing a huge file costs a tenth of a
+    /// second after each edit).
+    pub db: &'a btc_lang::db::Database,
+    pub file: btc_lang::db::SourceFile,
+    pub tokens: std::cell::OnceCell<Tokens<'a>>,
 }
 
-impl FileSyntax<'_> {
+impl<'a> FileSyntax<'a> {
+    /// The file's tokens (lexed once per text by the database).
+    pub fn tokens(&self) -> &Tokens<'a> {
+        self.tokens
+            .get_or_init(|| Tokens::of(btc_lang::db::rules_tokens(self.db, self.file)))
+    }
+
     /// The item holding a byte offset.
     pub fn item_at(&self, offset: u32) -> Option<usize> {
         let i = self.items.partition_point(|n| n.offset <= offset);

@@ -43,7 +43,7 @@ pub fn references(db: &dyn Db, file: SourceFile) -> Vec<Reference> {
     let id = crate::db::file_id(db, file);
     let mut out = Vec::new();
     for n in &parsed_rules(db, file).items {
-        let (kind, path) = match &n.item {
+        let (kind, path) = match &*n.item {
             Item::Domain { path, .. } => (RefKind::Domain, path),
             Item::Problem { path, .. } => (RefKind::Problem, path),
             Item::Import {

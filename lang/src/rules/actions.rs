@@ -94,7 +94,7 @@ mod tests {
 
     fn parts(pattern: &str) -> Vec<NamePart> {
         let p = parse_rules(&format!("rule ({pattern}) => skip"), 0);
-        match p.items.into_iter().next().unwrap().item {
+        match p.items.into_iter().next().unwrap().item.as_ref().clone() {
             Item::Rule(r) => r.pattern.name,
             other => panic!("{other:?}"),
         }

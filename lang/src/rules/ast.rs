@@ -506,5 +506,7 @@ impl Item {
 pub struct ItemNode {
     /// Byte offset of the item's first token; the item's spans are relative to it.
     pub offset: u32,
-    pub item: Item,
+    /// Shared with the database's memo of the item's parse, so that
+    /// assembling a file of tens of thousands of items copies none.
+    pub item: std::sync::Arc<Item>,
 }

@@ -28,7 +28,7 @@ pub struct Decls {
 impl Decls {
     pub fn add_items(&mut self, items: &[ItemNode]) {
         for i in items {
-            match &i.item {
+            match &*i.item {
                 Item::Node(n) => {
                     self.nodes
                         .entry(n.name.text.clone())

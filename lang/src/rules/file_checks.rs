@@ -280,7 +280,8 @@ pub fn unused(heads: &[ItemHead], uses: &[&ItemUses]) -> Vec<Finding> {
     if uses.iter().any(|u| u.broken) || heads.iter().any(|h| h.kind == HeadKind::Error) {
         return Vec::new();
     }
-    let used: BTreeSet<&str> = uses
+    // Hashed: a huge file uses a hundred thousand names.
+    let used: rustc_hash::FxHashSet<&str> = uses
         .iter()
         .flat_map(|u| u.names.iter().map(String::as_str))
         .collect();

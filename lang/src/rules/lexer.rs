@@ -119,19 +119,52 @@ fn starts_something(text: &str, i: usize) -> bool {
 /// the parser on top is chumsky. Never fails: bad characters become
 /// [`Tok::Error`] tokens with a diagnostic.
 pub fn lex(text: &str, file: FileId) -> Lexed {
-    lex_keeping(text, file, None)
+    lex_keeping(text, file)
+}
+
+/// What [`lex_each`] leaves besides the tokens it hands over.
+pub struct LexedRest {
+    pub comments: Vec<Comment>,
+    pub diagnostics: Vec<Diagnostic>,
 }
 
 /// [`lex`] for cutting a file into items: the same tokens, spans, comments
-/// and diagnostics, but a name is kept only if `keep` accepts it (others
-/// are empty, as are variables and strings). Every token of a huge file
-/// is then no allocation: only its items are lexed again with their names.
-pub fn lex_for_cutting(text: &str, file: FileId, keep: &dyn Fn(&str) -> bool) -> Lexed {
-    lex_keeping(text, file, Some(keep))
+/// and diagnostics, but each token is handed to `sink` instead of kept,
+/// and a name is kept only if `keep` accepts it (others are empty, as are
+/// variables and strings). Every token of a huge file is then no
+/// allocation, and there is no list of them: only its items are lexed
+/// again with their names.
+pub fn lex_each(
+    text: &str,
+    file: FileId,
+    keep: &dyn Fn(&str) -> bool,
+    sink: &mut dyn FnMut(Tok, Span),
+) -> LexedRest {
+    lex_into(text, file, Some(keep), sink)
 }
 
-/// Lexes, keeping every name (`keep` is `None`) or those it accepts.
-fn lex_keeping(text: &str, file: FileId, keep: Option<&dyn Fn(&str) -> bool>) -> Lexed {
+/// Lexes, keeping every name.
+fn lex_keeping(text: &str, file: FileId) -> Lexed {
+    // About one token per 8 bytes in real files: reserving for one per
+    // 6 saves a huge file's token list its copies as it grows (each
+    // into fresh pages), and costs nothing for what stays untouched.
+    let mut tokens = Vec::with_capacity(text.len() / 6 + 4);
+    let rest = lex_into(text, file, None, &mut |t, s| tokens.push((t, s)));
+    Lexed {
+        tokens,
+        comments: rest.comments,
+        diagnostics: rest.diagnostics,
+    }
+}
+
+/// Lexes into `sink`, keeping every name (`keep` is `None`) or those it
+/// accepts.
+fn lex_into(
+    text: &str,
+    file: FileId,
+    keep: Option<&dyn Fn(&str) -> bool>,
+    sink: &mut dyn FnMut(Tok, Span),
+) -> LexedRest {
     let all = keep.is_none();
     let owned = |s: &str| {
         if keep.is_none_or(|k| k(s)) {
@@ -141,8 +174,7 @@ fn lex_keeping(text: &str, file: FileId, keep: Option<&dyn Fn(&str) -> bool>) ->
         }
     };
     let b = text.as_bytes();
-    let mut out = Lexed {
-        tokens: Vec::new(),
+    let mut out = LexedRest {
         comments: Vec::new(),
         diagnostics: Vec::new(),
     };
@@ -304,7 +336,7 @@ fn lex_keeping(text: &str, file: FileId, keep: Option<&dyn Fn(&str) -> bool>) ->
         if !matches!(tok, Tok::Error(_)) {
             last_code_end = Some(i);
         }
-        out.tokens.push((tok, span(start, i)));
+        sink(tok, span(start, i));
     }
     errors.finish(&mut out.diagnostics, span(b.len(), b.len()));
     out

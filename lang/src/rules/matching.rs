@@ -191,7 +191,15 @@ mod tests {
     fn rule(text: &str) -> Rule {
         let parsed = parse_rules(text, 0);
         assert!(parsed.diagnostics.is_empty(), "{:#?}", parsed.diagnostics);
-        match parsed.items.into_iter().next().unwrap().item {
+        match parsed
+            .items
+            .into_iter()
+            .next()
+            .unwrap()
+            .item
+            .as_ref()
+            .clone()
+        {
             Item::Rule(r) => r,
             other => panic!("{other:?}"),
         }

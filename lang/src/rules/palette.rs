@@ -136,7 +136,7 @@ pub fn parse_palette(text: &str, file: FileId) -> (Vec<ItemNode>, Vec<Diagnostic
                             if empty {
                                 items.push(ItemNode {
                                     offset: 0,
-                                    item: Item::Node(decl),
+                                    item: std::sync::Arc::new(Item::Node(decl)),
                                 });
                             } else {
                                 current = Some(decl);
@@ -212,7 +212,7 @@ pub fn parse_palette(text: &str, file: FileId) -> (Vec<ItemNode>, Vec<Diagnostic
                         if let Some(d) = current.take() {
                             items.push(ItemNode {
                                 offset: 0,
-                                item: Item::Node(d),
+                                item: std::sync::Arc::new(Item::Node(d)),
                             });
                         }
                     }
@@ -284,7 +284,7 @@ mod tests {
         let (items, diags) = parse_palette(text, 7);
         let decls: Vec<&NodeDecl> = items
             .iter()
-            .map(|i| match &i.item {
+            .map(|i| match &*i.item {
                 Item::Node(n) => n,
                 _ => unreachable!(),
             })

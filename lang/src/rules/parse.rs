@@ -4,7 +4,7 @@
 //! becomes [`Item::Error`] and the others still parse.
 
 use super::ast::*;
-use super::lexer::{lex, lex_for_cutting, Comment, Tok};
+use super::lexer::{lex, lex_each, Comment, Tok};
 use btc_ir::vocab::{Arity, ControlName, NodeSpec};
 use btc_pddl::diagnostic::{codes, Diagnostic};
 use btc_pddl::lexer::{Tok as PTok, Token as PToken};
@@ -125,7 +125,10 @@ pub struct ParsedRules {
 }
 
 pub fn parse_rules(text: &str, file: FileId) -> ParsedRules {
-    parse_rules_with(text, file, |item| parse_item_text(item, file))
+    parse_rules_with(text, file, |item| {
+        let (item, diagnostics) = parse_item_text(item, file);
+        (std::sync::Arc::new(item), diagnostics)
+    })
 }
 
 /// [`parse_rules`] with each item's text parsed by `parse_item`, which the
@@ -134,16 +137,22 @@ pub fn parse_rules(text: &str, file: FileId) -> ParsedRules {
 pub fn parse_rules_with(
     text: &str,
     file: FileId,
-    mut parse_item: impl FnMut(&str) -> (Item, Vec<Diagnostic>),
+    mut parse_item: impl FnMut(&str) -> (std::sync::Arc<Item>, Vec<Diagnostic>),
 ) -> ParsedRules {
     // Cutting needs only the item keywords' names: the other tokens'
-    // names are left unallocated (each item is lexed again to parse it).
-    let lexed = lex_for_cutting(text, file, &|w| ITEM_KEYWORDS.contains(&w));
+    // names are left unallocated, and the tokens are not kept (each item
+    // is lexed again to parse it).
+    let mut cut = Cutter::new(text);
+    let lexed = lex_each(
+        text,
+        file,
+        &|w| ITEM_KEYWORDS.contains(&w),
+        &mut |t, span| cut.token(&t, span),
+    );
     let mut diagnostics = lexed.diagnostics;
-    let mut items = Vec::with_capacity(lexed.tokens.len() / 16);
-    for chunk in split_items(&lexed.tokens, text) {
-        let offset = lexed.tokens[chunk.start].1.start;
-        let end = lexed.tokens[chunk.end - 1].1.end;
+    let chunks = cut.finish();
+    let mut items = Vec::with_capacity(chunks.len());
+    for (offset, end) in chunks {
         let (item, diags) = parse_item(&text[offset as usize..end as usize]);
         diagnostics.extend(diags.into_iter().map(|d| shift(d, file, offset)));
         items.push(ItemNode { offset, item });
@@ -187,32 +196,50 @@ fn at_line_start(text: &str, offset: u32) -> bool {
     offset == 0 || text.as_bytes().get(offset as usize - 1) == Some(&b'\n')
 }
 
-fn split_items(tokens: &[(Tok, Span)], text: &str) -> Vec<std::ops::Range<usize>> {
-    let mut out = Vec::new();
-    let mut depth = 0usize;
-    let mut start = None;
-    for (i, (t, span)) in tokens.iter().enumerate() {
+/// Cuts a file into items as its tokens come: an item starts at an item
+/// keyword outside brackets or at the start of a line, and runs from its
+/// first token's start to its last token's end.
+struct Cutter<'t> {
+    text: &'t str,
+    depth: usize,
+    /// The current item's start, and the end of its last token so far.
+    current: Option<(u32, u32)>,
+    items: Vec<(u32, u32)>,
+}
+
+impl<'t> Cutter<'t> {
+    fn new(text: &'t str) -> Cutter<'t> {
+        Cutter {
+            text,
+            depth: 0,
+            current: None,
+            items: Vec::new(),
+        }
+    }
+
+    fn token(&mut self, t: &Tok, span: Span) {
         let is_kw = matches!(t, Tok::Ident(k) if ITEM_KEYWORDS.contains(&k.as_str()));
-        if is_kw && (depth == 0 || at_line_start(text, span.start)) {
-            if let Some(s) = start {
-                out.push(s..i);
+        if is_kw && (self.depth == 0 || at_line_start(self.text, span.start)) {
+            if let Some(item) = self.current.take() {
+                self.items.push(item);
             }
-            start = Some(i);
-            depth = 0;
+            self.depth = 0;
         }
-        if start.is_none() {
-            start = Some(i); // text before the first keyword is an item of its own (an error)
-        }
+        // Text before the first keyword is an item of its own (an error).
+        let item = self.current.get_or_insert((span.start, span.end));
+        item.1 = span.end;
         match t {
-            Tok::Punct("(" | "{" | "[") => depth += 1,
-            Tok::Punct(")" | "}" | "]") => depth = depth.saturating_sub(1),
+            Tok::Punct("(" | "{" | "[") => self.depth += 1,
+            Tok::Punct(")" | "}" | "]") => self.depth = self.depth.saturating_sub(1),
             _ => {}
         }
     }
-    if let Some(s) = start {
-        out.push(s..tokens.len());
+
+    /// Each item's start and end.
+    fn finish(mut self) -> Vec<(u32, u32)> {
+        self.items.extend(self.current);
+        self.items
     }
-    out
 }
 
 fn rel(span: Span, offset: u32) -> SimpleSpan {
@@ -1159,7 +1186,7 @@ mod tests {
             assert!(p
                 .items
                 .iter()
-                .all(|i| !matches!(i.item, Item::Error { .. })));
+                .all(|i| !matches!(*i.item, Item::Error { .. })));
         }
     }
 
@@ -1167,7 +1194,7 @@ mod tests {
     fn reads_patterns_guards_and_effects() {
         let p = parse("rule (PICK_{op} ?a [?loc]) where op in markers, ?a != ?loc {\n  Pick(agent: ?A, marker: markers[op])\n  effect (and (holding ?a) (not (free ?a)))\n}");
         assert!(p.diagnostics.is_empty(), "{:#?}", p.diagnostics);
-        let Item::Rule(r) = &p.items[0].item else {
+        let Item::Rule(r) = &*p.items[0].item else {
             panic!()
         };
         assert_eq!(r.pattern.name_text(), "PICK_{op}");
@@ -1188,7 +1215,7 @@ mod tests {
     fn spans_are_relative_to_their_item() {
         let p = parse("action A()\n\naction B(x: int)");
         assert_eq!(p.items[1].offset, 12);
-        let Item::Node(n) = &p.items[1].item else {
+        let Item::Node(n) = &*p.items[1].item else {
             panic!()
         };
         assert_eq!(n.name.span, Span::new(0, 7, 8));
@@ -1200,7 +1227,7 @@ mod tests {
         let p = parse(text);
         assert_eq!(codes(&p).len(), 2, "{:#?}", p.diagnostics);
         assert_eq!(p.items.len(), 3);
-        assert!(matches!(p.items[2].item, Item::Node(_)));
+        assert!(matches!(*p.items[2].item, Item::Node(_)));
     }
 
     #[test]
@@ -1210,14 +1237,14 @@ mod tests {
         let p = parse(text);
         assert_eq!(p.items.len(), 2);
         assert_eq!(p.diagnostics.len(), 1, "{:#?}", p.diagnostics);
-        assert!(matches!(p.items[1].item, Item::Rule(_)));
+        assert!(matches!(*p.items[1].item, Item::Rule(_)));
     }
 
     #[test]
     fn interpolation_and_escapes() {
         let p = parse("tree T() { sequence \"move {?Robot} to {op} \\{x\\}\" { } }");
         assert!(p.diagnostics.is_empty(), "{:#?}", p.diagnostics);
-        let Item::Tree(t) = &p.items[0].item else {
+        let Item::Tree(t) = &*p.items[0].item else {
             panic!()
         };
         let Template::Control { name: Some(s), .. } = &t.body[0] else {
@@ -1233,7 +1260,7 @@ mod tests {
         let src = r#"tree T() { sequence "a\"b\\c\n{?x}d" { } }"#;
         let p = parse(src);
         assert!(p.diagnostics.is_empty(), "{:#?}", p.diagnostics);
-        let Item::Tree(t) = &p.items[0].item else {
+        let Item::Tree(t) = &*p.items[0].item else {
             panic!()
         };
         let Template::Control { name: Some(s), .. } = &t.body[0] else {
