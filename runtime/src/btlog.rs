@@ -293,7 +293,7 @@ impl Writer<'_, '_> {
                 .into_iter()
                 .map(|(k, v)| (k.to_owned(), v))
                 .collect(),
-            Kind::Switch { variable, cases } => std::iter::once(("variable".into(), variable))
+            Kind::Switch { variable, cases } => std::iter::once(("variable".into(), &**variable))
                 .chain(
                     cases
                         .iter()
@@ -328,13 +328,13 @@ impl Writer<'_, '_> {
                     (
                         "start_effect".into(),
                         text(
-                            start_effect.as_ref(),
+                            start_effect.as_deref(),
                             info.and_then(|s| s.eff_start.as_ref()),
                         ),
                     ),
                     (
                         "end_effect".into(),
-                        text(end_effect.as_ref(), info.and_then(|s| s.eff_end.as_ref())),
+                        text(end_effect.as_deref(), info.and_then(|s| s.eff_end.as_ref())),
                     ),
                     (
                         "start_condition".into(),

@@ -33,7 +33,7 @@ pub enum Kind {
     /// `Switch2`..`Switch6`: the child whose case equals `variable`, or the
     /// last (default) child.
     Switch {
-        variable: PortValue,
+        variable: Box<PortValue>,
         cases: Vec<PortValue>,
     },
     /// `Delay`: the child is ticked once `msec` (simulated) have passed.
@@ -59,8 +59,8 @@ pub enum Kind {
     /// XML `KbStep` attributes) take the place of the step table's.
     Step {
         step: usize,
-        start_effect: Option<btc_pddl::logic::Effect>,
-        end_effect: Option<btc_pddl::logic::Effect>,
+        start_effect: Option<Box<btc_pddl::logic::Effect>>,
+        end_effect: Option<Box<btc_pddl::logic::Effect>>,
         /// The step's conditions as the XML gives them (`start_condition`,
         /// `over_all_condition`, `end_condition`); `None` when it gives none
         /// (they are then the domain action's, grounded from the name).
@@ -393,5 +393,29 @@ impl Kind {
         let params = self.vocab().map_or(&[][..], |n| n.spec().params);
         debug_assert_eq!(params.len(), values.len(), "{self:?}");
         params.iter().map(|p| p.port).zip(values).collect()
+    }
+}
+
+#[cfg(test)]
+mod size_tests {
+    use super::*;
+
+    /// A parsed document holds one `SNode` per element, and a parent's
+    /// children vector copies them as it grows: rare, large variants sit
+    /// behind a pointer.
+    #[test]
+    fn nodes_stay_small() {
+        // 280 bytes (Kind 208) before the step's effects and the switch's
+        // variable were boxed; loading 10,001 nodes copied them about twice.
+        assert!(
+            std::mem::size_of::<Kind>() <= 56,
+            "Kind: {}",
+            std::mem::size_of::<Kind>()
+        );
+        assert!(
+            std::mem::size_of::<SNode>() <= 128,
+            "SNode: {}",
+            std::mem::size_of::<SNode>()
+        );
     }
 }

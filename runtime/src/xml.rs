@@ -336,7 +336,10 @@ fn node_of(mut e: Elem) -> Result<SNode, LoadError> {
                             .unwrap_or(PortValue::Text(String::new()))
                     })
                     .collect();
-                Kind::Switch { variable, cases }
+                Kind::Switch {
+                    variable: Box::new(variable),
+                    cases,
+                }
             }
             "Precondition" => Kind::Precondition {
                 code: e
@@ -374,8 +377,9 @@ fn node_of(mut e: Elem) -> Result<SNode, LoadError> {
                     })?;
                 Kind::Step {
                     step: step - 1,
-                    start_effect: pddl(&e, "start_effect", decode::effect, "an effect")?,
-                    end_effect: pddl(&e, "end_effect", decode::effect, "an effect")?,
+                    start_effect: pddl(&e, "start_effect", decode::effect, "an effect")?
+                        .map(Box::new),
+                    end_effect: pddl(&e, "end_effect", decode::effect, "an effect")?.map(Box::new),
                     conditions: step_conditions(&e)?,
                 }
             }

@@ -315,7 +315,7 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
             }
             Kind::Switch { variable, cases } => {
                 arity(&[cases.len() + 1], self)?;
-                let mut ports = vec![("variable".to_owned(), variable.clone())];
+                let mut ports = vec![("variable".to_owned(), (**variable).clone())];
                 for (k, c) in cases.iter().enumerate() {
                     ports.push((format!("case_{}", k + 1), c.clone()));
                 }
@@ -380,14 +380,14 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
                 let label = format!("`{}`", self.e.steps[*k].label);
                 if let Some(f) = self
                     .e
-                    .kb_effect(start_effect.as_ref(), &label)
+                    .kb_effect(start_effect.as_deref(), &label)
                     .map_err(|e| e.at_opt(n.at))?
                 {
                     self.e.steps[*k].eff_start = Some(f);
                 }
                 if let Some(f) = self
                     .e
-                    .kb_effect(end_effect.as_ref(), &label)
+                    .kb_effect(end_effect.as_deref(), &label)
                     .map_err(|e| e.at_opt(n.at))?
                 {
                     self.e.steps[*k].eff_end = Some(f);
