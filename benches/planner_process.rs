@@ -248,6 +248,11 @@ fn version() {
             median(n, || timed(Command::new(CARGO_BTC).arg("--version"))).expect("btc runs");
         println!("  (cargo's dynamically linked build: {:.2} ms)", ms(t));
     }
+    // What starting any process costs here, measured the same way: the
+    // floor under the figure above.
+    if let Some((t, _)) = median(n, || timed(&mut Command::new("true"))) {
+        println!("  (`true`, a process that does nothing: {:.2} ms)", ms(t));
+    }
 }
 
 fn ariac() {
