@@ -15,16 +15,8 @@ fn parts(pattern: &str) -> Vec<NamePart> {
         "{pattern}: {:#?}",
         parsed.diagnostics
     );
-    match parsed
-        .items
-        .into_iter()
-        .next()
-        .unwrap()
-        .item
-        .as_ref()
-        .clone()
-    {
-        Item::Rule(r) => r.pattern.name,
+    match &*parsed.items[0].item {
+        Item::Rule(r) => r.pattern.name.clone(),
         other => panic!("{pattern}: {other:?}"),
     }
 }

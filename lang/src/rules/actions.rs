@@ -94,8 +94,8 @@ mod tests {
 
     fn parts(pattern: &str) -> Vec<NamePart> {
         let p = parse_rules(&format!("rule ({pattern}) => skip"), 0);
-        match p.items.into_iter().next().unwrap().item.as_ref().clone() {
-            Item::Rule(r) => r.pattern.name,
+        match &*p.items[0].item {
+            Item::Rule(r) => r.pattern.name.clone(),
             other => panic!("{other:?}"),
         }
     }

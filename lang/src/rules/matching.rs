@@ -191,16 +191,8 @@ mod tests {
     fn rule(text: &str) -> Rule {
         let parsed = parse_rules(text, 0);
         assert!(parsed.diagnostics.is_empty(), "{:#?}", parsed.diagnostics);
-        match parsed
-            .items
-            .into_iter()
-            .next()
-            .unwrap()
-            .item
-            .as_ref()
-            .clone()
-        {
-            Item::Rule(r) => r,
+        match &*parsed.items[0].item {
+            Item::Rule(r) => r.clone(),
             other => panic!("{other:?}"),
         }
     }
