@@ -3,16 +3,17 @@
 
 use btc_pddl::diagnostic::{codes, Cap, Diagnostic};
 use btc_pddl::source::{FileId, Span};
+use smol_str::SmolStr;
 use std::fmt;
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum Tok {
     /// A name: keywords are names too, told apart by the parser.
-    Ident(String),
+    Ident(SmolStr),
     /// `?x`, without the `?`.
-    Var(String),
+    Var(SmolStr),
     /// A string literal's raw contents (escapes not yet processed).
-    Str(String),
+    Str(SmolStr),
     Int(i64),
     Float(f64),
     Punct(&'static str),
@@ -168,9 +169,9 @@ fn lex_into(
     let all = keep.is_none();
     let owned = |s: &str| {
         if keep.is_none_or(|k| k(s)) {
-            s.to_owned()
+            SmolStr::new(s)
         } else {
-            String::new()
+            SmolStr::default()
         }
     };
     let b = text.as_bytes();
@@ -239,9 +240,9 @@ fn lex_into(
             if closed {
                 i = j + 1;
                 Tok::Str(if all {
-                    text[start + 1..j].to_owned()
+                    SmolStr::new(&text[start + 1..j])
                 } else {
-                    String::new()
+                    SmolStr::default()
                 })
             } else {
                 i = j;
@@ -255,9 +256,9 @@ fn lex_into(
                     .with_hint("strings end on the line they start on"),
                 );
                 Tok::Str(if all {
-                    text[start + 1..j].to_owned()
+                    SmolStr::new(&text[start + 1..j])
                 } else {
-                    String::new()
+                    SmolStr::default()
                 })
             }
         } else if c == b'?' && char_at(text, i + 1).is_some_and(is_ident_start) {
@@ -265,9 +266,9 @@ fn lex_into(
             let j = ident_end(text, i + 1 + first);
             i = j;
             Tok::Var(if all {
-                text[start + 1..j].to_owned()
+                SmolStr::new(&text[start + 1..j])
             } else {
-                String::new()
+                SmolStr::default()
             })
         } else if c.is_ascii_digit() || (c == b'-' && b.get(i + 1).is_some_and(u8::is_ascii_digit))
         {

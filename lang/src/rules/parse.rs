@@ -14,6 +14,7 @@ use btc_pddl::source::{FileId, Span};
 use chumsky::cache::{Cache, Cached};
 use chumsky::input::{MappedInput, ValueInput};
 use chumsky::prelude::*;
+use smol_str::SmolStr;
 use std::cell::RefCell;
 use std::collections::HashMap;
 use std::rc::Rc;
@@ -453,7 +454,8 @@ fn rel_range(start: usize, end: usize) -> SimpleSpan {
 }
 
 /// Parses one item's tokens, which it takes out of `tokens` (a token
-/// passed on to the parser is moved, not copied).
+/// passed on to the parser is moved, not copied): first without building
+/// error messages, then, only for an item that has errors, again with them.
 fn parse_item(
     tokens: &mut [(Tok, Span)],
     text: &str,
@@ -466,7 +468,32 @@ fn parse_item(
         0,
         (tokens.last().map_or(offset, |t| t.1.end) - offset) as usize,
     );
-    // Pre-pass: relative spans, PDDL groups read, nesting bounded.
+    let Some(input) = prepare(tokens, text, offset, file, &mut diags) else {
+        return (Item::Error { span: whole }, diags);
+    };
+    let eoi = SimpleSpan::from(whole.end as usize..whole.end as usize);
+    let parsers = cached_item_parsers(file);
+    if let Some(item) = parse_quick(&parsers, &input, eoi) {
+        return (item, diags);
+    }
+    let (item, errors) = parse_rich(&parsers, &input, eoi);
+    for e in errors {
+        let d = rich_to_diagnostic(&e, file);
+        diags.push(super::typo::keyword_hint(d, &input));
+    }
+    (item.unwrap_or(Item::Error { span: whole }), diags)
+}
+
+/// The parser's input for an item's tokens: spans relative to the item,
+/// PDDL groups and a rule's name pattern read into tokens of their own;
+/// `None` (reported) when brackets and decorators nest too deep.
+fn prepare(
+    tokens: &mut [(Tok, Span)],
+    text: &str,
+    offset: u32,
+    file: FileId,
+    diags: &mut Vec<Diagnostic>,
+) -> Option<Vec<(Tok, SimpleSpan)>> {
     let mut input: Vec<(Tok, SimpleSpan)> = Vec::with_capacity(tokens.len());
     let is_condition = matches!(tokens.first(), Some((Tok::Ident(k), _)) if k == "condition");
     let is_rule = matches!(tokens.first(), Some((Tok::Ident(k), _)) if k == "rule")
@@ -476,7 +503,7 @@ fn parse_item(
     while i < tokens.len() {
         let (t, span) = &tokens[i];
         if i == 2 && is_rule {
-            let (tok, next) = read_name_pattern(tokens, i, text, offset, file, &mut diags);
+            let (tok, next) = read_name_pattern(tokens, i, text, offset, file, diags);
             if let Some(tok) = tok {
                 input.push(tok);
                 i = next;
@@ -488,7 +515,7 @@ fn parse_item(
             let effect = matches!(prev, Some(Tok::Ident(k)) if k == "effect");
             let formula = is_condition && matches!(prev, Some(Tok::Punct("=")));
             if effect || formula {
-                let (tok, next) = read_pddl_group(tokens, i, offset, file, effect, &mut diags);
+                let (tok, next) = read_pddl_group(tokens, i, offset, file, effect, diags);
                 input.push(tok);
                 i = next;
                 continue;
@@ -508,24 +535,42 @@ fn parse_item(
                 )
                 .with_hint("split the template into `tree`s that call each other"),
             );
-            return (Item::Error { span: whole }, diags);
+            return None;
         }
         // Every look at the tokens (above) is at `i` or after it.
         let span = rel(*span, offset);
         input.push((std::mem::replace(&mut tokens[i].0, Tok::BadPddl), span));
         i += 1;
     }
-    let eoi = SimpleSpan::from(whole.end as usize..whole.end as usize);
-    let parser = cached_item_parser(file);
-    let (item, errors) = parser
+    Some(input)
+}
+
+/// The item, if it parses without any error.
+fn parse_quick(
+    parsers: &ItemParsers,
+    input: &[(Tok, SimpleSpan)],
+    eoi: SimpleSpan,
+) -> Option<Item> {
+    let quick = parsers
+        .quick
         .get()
-        .parse(input.as_slice().map(eoi, split_token as SplitToken<'_>))
-        .into_output_errors();
-    for e in errors {
-        let d = rich_to_diagnostic(&e, file);
-        diags.push(super::typo::keyword_hint(d, &input));
+        .parse(input.map(eoi, split_token as SplitToken<'_>));
+    if quick.has_errors() {
+        return None;
     }
-    (item.unwrap_or(Item::Error { span: whole }), diags)
+    quick.into_output()
+}
+
+fn parse_rich<'t>(
+    parsers: &ItemParsers,
+    input: &'t [(Tok, SimpleSpan)],
+    eoi: SimpleSpan,
+) -> (Option<Item>, Vec<RichErr<'t>>) {
+    parsers
+        .rich
+        .get()
+        .parse(input.map(eoi, split_token as SplitToken<'_>))
+        .into_output_errors()
 }
 
 fn rich_to_diagnostic(e: &Rich<'_, Tok, SimpleSpan>, file: FileId) -> Diagnostic {
@@ -551,7 +596,35 @@ fn rich_to_diagnostic(e: &Rich<'_, Tok, SimpleSpan>, file: FileId) -> Diagnostic
     Diagnostic::error(codes::R_SYNTAX, span, message)
 }
 
-type Err<'t> = extra::Err<Rich<'t, Tok, SimpleSpan>>;
+/// What the item parser needs of its error type: chumsky's error, labels,
+/// and messages of its own. Two types have it: [`Rich`], what users read,
+/// and [`EmptyErr`], for a first attempt that builds no expected-token
+/// sets as alternatives fail (most of a parse's work otherwise), since
+/// nearly every item parses without errors. An item that has errors is
+/// parsed again with [`Rich`]; the error type does not steer the parse, so
+/// an item without errors reads the same either way.
+trait ItemError<'t, I: Input<'t, Span = SimpleSpan>>:
+    chumsky::error::Error<'t, I> + chumsky::label::LabelError<'t, I, &'static str>
+{
+    fn custom(span: SimpleSpan, message: String) -> Self;
+}
+
+impl<'t, I: Input<'t, Token = Tok, Span = SimpleSpan>> ItemError<'t, I>
+    for Rich<'t, Tok, SimpleSpan>
+{
+    fn custom(span: SimpleSpan, message: String) -> Self {
+        Rich::custom(span, message)
+    }
+}
+
+impl<'t, I: Input<'t, Span = SimpleSpan>> ItemError<'t, I> for EmptyErr {
+    fn custom(_: SimpleSpan, _: String) -> Self {
+        EmptyErr::default()
+    }
+}
+
+type Err<R> = extra::Err<R>;
+type RichErr<'t> = Rich<'t, Tok, SimpleSpan>;
 
 /// What the item parser reads: an item's tokens with their relative spans.
 type ItemInput<'t> = MappedInput<'t, Tok, SimpleSpan, &'t [(Tok, SimpleSpan)], SplitToken<'t>>;
@@ -561,51 +634,76 @@ fn split_token(pair: &(Tok, SimpleSpan)) -> (&Tok, &SimpleSpan) {
     (&pair.0, &pair.1)
 }
 
-/// The item parser of one file, built once: building it (a few hundred
+/// The item parsers of one file, built once: building one (a few hundred
 /// combinators, a string per keyword) cost more than parsing a typical
 /// item, and a file has tens of thousands of items. chumsky's [`Cache`]
-/// holds it for inputs of any lifetime.
-struct ItemParser {
+/// holds them for inputs of any lifetime.
+struct RichItemParser {
     file: FileId,
 }
 
-impl Cached for ItemParser {
-    type Parser<'t> = Boxed<'t, 't, ItemInput<'t>, Item, Err<'t>>;
+struct QuickItemParser {
+    file: FileId,
+}
+
+impl Cached for RichItemParser {
+    type Parser<'t> = Boxed<'t, 't, ItemInput<'t>, Item, Err<RichErr<'t>>>;
 
     fn make_parser<'t>(self) -> Self::Parser<'t> {
         item_parser(self.file).boxed()
     }
 }
 
+impl Cached for QuickItemParser {
+    type Parser<'t> = Boxed<'t, 't, ItemInput<'t>, Item, Err<EmptyErr>>;
+
+    fn make_parser<'t>(self) -> Self::Parser<'t> {
+        item_parser(self.file).boxed()
+    }
+}
+
+/// Both parsers of one file.
+struct ItemParsers {
+    quick: Cache<QuickItemParser>,
+    rich: Cache<RichItemParser>,
+}
+
 thread_local! {
     /// Per thread, since a parser shares its recursive parts through `Rc`;
     /// per file, since the parser puts the file in every span it makes.
-    static ITEM_PARSERS: RefCell<HashMap<FileId, Rc<Cache<ItemParser>>>> =
+    static ITEM_PARSERS: RefCell<HashMap<FileId, Rc<ItemParsers>>> =
         RefCell::default();
 }
 
-fn cached_item_parser(file: FileId) -> Rc<Cache<ItemParser>> {
+fn cached_item_parsers(file: FileId) -> Rc<ItemParsers> {
     ITEM_PARSERS.with(|parsers| {
         parsers
             .borrow_mut()
             .entry(file)
-            .or_insert_with(|| Rc::new(Cache::new(ItemParser { file })))
+            .or_insert_with(|| {
+                Rc::new(ItemParsers {
+                    quick: Cache::new(QuickItemParser { file }),
+                    rich: Cache::new(RichItemParser { file }),
+                })
+            })
             .clone()
     })
 }
 
-fn kw<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
+fn kw<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>, R: ItemError<'t, I> + 't>(
     word: &'static str,
-) -> impl Parser<'t, I, (), Err<'t>> + Clone {
-    just(Tok::Ident(word.to_owned())).ignored().labelled(word)
+) -> impl Parser<'t, I, (), Err<R>> + Clone {
+    just(Tok::Ident(SmolStr::new_static(word)))
+        .ignored()
+        .labelled(word)
 }
 
 /// Templates in braces; a block that does not parse becomes one error
 /// node and parsing goes on after its closing brace.
-fn block_of<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
-    template: impl Parser<'t, I, Template, Err<'t>> + Clone,
+fn block_of<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>, R: ItemError<'t, I> + 't>(
+    template: impl Parser<'t, I, Template, Err<R>> + Clone,
     file: FileId,
-) -> impl Parser<'t, I, Vec<Template>, Err<'t>> + Clone {
+) -> impl Parser<'t, I, Vec<Template>, Err<R>> + Clone {
     template
         .repeated()
         .collect::<Vec<Template>>()
@@ -625,38 +723,39 @@ fn block_of<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
         )))
 }
 
-fn punct<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
+fn punct<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>, R: ItemError<'t, I> + 't>(
     p: &'static str,
-) -> impl Parser<'t, I, (), Err<'t>> + Clone {
+) -> impl Parser<'t, I, (), Err<R>> + Clone {
     just(Tok::Punct(p)).ignored()
 }
 
-fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
+fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>, R: ItemError<'t, I> + 't>(
     file: FileId,
-) -> impl Parser<'t, I, Item, Err<'t>> {
+) -> impl Parser<'t, I, Item, Err<R>> {
     let sp = move |s: SimpleSpan| Span::new(file, s.start, s.end);
     let ident = select! { Tok::Ident(s) => s }
-        .map_with(move |text, e| Ident::new(text, sp(e.span())))
+        .map_with(move |text: SmolStr, e| Ident::new(text.into(), sp(e.span())))
         .labelled("a name");
     // Variables are PDDL's, so they are shown (and compared) folded.
     let var = select! { Tok::Var(s) => s }
-        .map_with(move |text: String, e| Ident::new(Key::new(&text).into_string(), sp(e.span())))
+        .map_with(move |text: SmolStr, e| Ident::new(Key::new(&text).into_string(), sp(e.span())))
         .labelled("a variable");
     let int = select! { Tok::Int(n) => n }.labelled("a whole number");
     let count = int.try_map(|n, span| {
-        u32::try_from(n).map_err(|_| Rich::custom(span, "expected a count from 0 to 4294967295"))
+        u32::try_from(n)
+            .map_err(|_| R::custom(span, "expected a count from 0 to 4294967295".into()))
     });
     // A bad escape or interpolation is reported, and the string still
     // parses (as its raw text): failing here would let chumsky merge the
     // error into "expected a string, found a string".
     let strlit = select! { Tok::Str(s) => s }
-        .validate(move |raw: String, e, emitter| {
+        .validate(move |raw: SmolStr, e, emitter| {
             let span: SimpleSpan = e.span();
             interpolate(&raw, file, span.start).unwrap_or_else(|(msg, at)| {
-                emitter.emit(Rich::custom(at, msg));
+                emitter.emit(R::custom(at, msg));
                 StrLit {
                     span: Span::new(file, span.start, span.end),
-                    parts: vec![StrPart::Text { text: raw }],
+                    parts: vec![StrPart::Text { text: raw.into() }],
                     escapes: Vec::new(),
                 }
             })
@@ -749,7 +848,7 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
             .collect::<Vec<_>>()
             .delimited_by(punct("("), punct(")"));
         let control_kind = control_name.then(control_args.or_not()).try_map(
-            |(name, args): (ControlName, Option<Vec<(String, u32)>>), span| {
+            |(name, args): (ControlName, Option<Vec<(SmolStr, u32)>>), span| {
                 let spec = name.spec();
                 let given = args.unwrap_or_default();
                 let names = given.iter().map(|(n, _)| n.as_str());
@@ -759,7 +858,7 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
                         .iter()
                         .map(|p| format!("{}: N", p.name))
                         .collect();
-                    return Err(Rich::custom(
+                    return Err(R::custom(
                         span,
                         format!("expected `{}({})`", spec.keyword, shape.join(", ")),
                     ));
@@ -912,9 +1011,9 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
     .then(punct("=").ignore_then(formula).or_not())
     .validate(move |(((kind, name), ports), formula), e, emitter| {
         if kind == NodeKind::Action && formula.is_some() {
-            emitter.emit(Rich::custom(
+            emitter.emit(R::custom(
                 e.span(),
-                "only a `condition` can be defined by a formula",
+                "only a `condition` can be defined by a formula".into(),
             ));
         }
         Item::Node(NodeDecl {
@@ -990,9 +1089,9 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>>(
     let object = strlit
         .try_map(|s: StrLit, span| match s.plain() {
             Some(text) => Ok(Ident::new(text, s.span)),
-            None => Err(Rich::custom(
+            None => Err(R::custom(
                 span,
-                "a guard compares with an object's name: a string without `{...}`",
+                "a guard compares with an object's name: a string without `{...}`".into(),
             )),
         })
         .map(|name| Operand::Object { name });
@@ -1163,6 +1262,66 @@ fn interpolate(raw: &str, file: FileId, start: usize) -> Result<StrLit, (String,
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn rules_files(dir: &std::path::Path, out: &mut Vec<std::path::PathBuf>) {
+        for entry in std::fs::read_dir(dir).expect("a readable folder") {
+            let path = entry.expect("a folder entry").path();
+            if path.is_dir() {
+                rules_files(&path, out);
+            } else if path.extension().is_some_and(|e| e == "btrules") {
+                out.push(path);
+            }
+        }
+    }
+
+    /// The quick parse (no error messages) is only sound if it fails
+    /// exactly where the rich one reports errors, and reads what the rich
+    /// one reads elsewhere: checked on every item of every rules file in
+    /// the repository, the diagnostics fixtures' broken items included.
+    #[test]
+    fn quick_and_rich_parses_agree_on_every_item() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+        let mut files = Vec::new();
+        for dir in ["examples", "tests", "lang/tests", "stdlib", "lsp/tests"] {
+            rules_files(&root.join(dir), &mut files);
+        }
+        let (mut items, mut broken) = (0, 0);
+        for path in &files {
+            let text = std::fs::read_to_string(path).expect("a UTF-8 rules file");
+            let parsers = cached_item_parsers(0);
+            parse_rules_with(&text, 0, |item| {
+                let mut lexed = lex(item, 0);
+                let mut diags = Vec::new();
+                if let Some(input) = prepare(&mut lexed.tokens, item, 0, 0, &mut diags) {
+                    let eoi = SimpleSpan::from(item.len()..item.len());
+                    let quick = parse_quick(&parsers, &input, eoi);
+                    let (rich, errors) = parse_rich(&parsers, &input, eoi);
+                    assert_eq!(
+                        quick.is_none(),
+                        !errors.is_empty(),
+                        "{}: {item}",
+                        path.display()
+                    );
+                    if quick.is_some() {
+                        assert_eq!(quick, rich, "{}: {item}", path.display());
+                    }
+                    items += 1;
+                    broken += usize::from(quick.is_none());
+                }
+                (
+                    std::sync::Arc::new(Item::Error {
+                        span: Span::new(0, 0, 0),
+                    }),
+                    Vec::new(),
+                )
+            });
+        }
+        assert!(
+            files.len() > 50 && items > 500 && broken > 20,
+            "{} files, {items} items, {broken} with errors",
+            files.len()
+        );
+    }
 
     fn parse(text: &str) -> ParsedRules {
         parse_rules(text, 0)
