@@ -7,29 +7,32 @@
 //! `lsp/clippy.toml` forbid `to_lowercase` and its relatives elsewhere.
 
 use serde::{Deserialize, Serialize};
+use smol_str::{SmolStr, StrExt};
 use std::fmt;
 
 /// A name folded for comparison: lower-cased exactly as the PDDL lexer
 /// lower-cases names, so a key compares equal to the PDDL front end's name.
 #[derive(Clone, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
 #[serde(transparent)]
-pub struct Key(String);
+pub struct Key(SmolStr);
 
 impl Key {
     /// Folds `text`.
     #[allow(clippy::disallowed_methods)] // the one place that folds
     pub fn new(text: &str) -> Key {
+        // Short keys live inline (no allocation): most names are short,
+        // and a huge file has hundreds of thousands of them.
         if text.is_ascii() {
-            Key(text.to_ascii_lowercase())
+            Key(text.to_ascii_lowercase_smolstr())
         } else {
-            Key(text.to_lowercase())
+            Key(text.to_lowercase_smolstr())
         }
     }
 
     /// A name the PDDL front end produced (already folded by its lexer).
     pub fn of_pddl(name: &str) -> Key {
         debug_assert_eq!(Key::new(name).0, name, "PDDL names are folded");
-        Key(name.to_owned())
+        Key(SmolStr::new(name))
     }
 
     pub fn as_str(&self) -> &str {
@@ -37,7 +40,7 @@ impl Key {
     }
 
     pub fn into_string(self) -> String {
-        self.0
+        self.0.into()
     }
 }
 

@@ -393,11 +393,17 @@ fn disjoint(var: &str, a: &Constraint, b: &Constraint, types: &TypeTable) -> Nev
 /// constraint when `t` fits one of its types; the constraints can be met
 /// together when some type of the domain meets them all.
 fn first_conflict(types: &TypeTable, cs: &[Constraint]) -> Option<(usize, usize)> {
-    let all: Vec<TypeId> = (0..types.len() as TypeId).collect();
-    let mut possible: Vec<TypeId> = all;
+    let meets = |t: TypeId, c: &Constraint| types.fits(&[t], c.types());
+    // The common case, one parameter's type, without collecting types: it
+    // runs for every variable of every rule with a guard.
+    if let [c] = cs {
+        let met = (0..types.len() as TypeId).any(|t| meets(t, c));
+        return (!met).then_some((0, 0));
+    }
+    let mut possible: Vec<TypeId> = (0..types.len() as TypeId).collect();
     for (i, c) in cs.iter().enumerate() {
-        let before = possible.clone();
-        possible.retain(|&t| types.fits(&[t], c.types()));
+        let next: Vec<TypeId> = possible.iter().copied().filter(|&t| meets(t, c)).collect();
+        let before = std::mem::replace(&mut possible, next);
         if possible.is_empty() {
             // Name the earlier constraint it conflicts with most directly.
             let j = (0..i)
