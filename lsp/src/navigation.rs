@@ -209,7 +209,9 @@ pub fn hover(a: &Analysis, offset: usize) -> Option<Hover> {
 /// template's keyword: not a port name (`delay: 3`), not in a call's
 /// parentheses or a PDDL formula.
 fn keyword_hover(a: &Analysis, offset: usize) -> Option<Hover> {
-    let t = &a.syntax.tokens();
+    // The item's tokens are enough: the checks below stop at its braces.
+    let item_tokens = a.syntax.item_tokens(offset as u32)?;
+    let t = &crate::syntax::Tokens::of(&item_tokens);
     let i = t.at(offset)?;
     let spec = btc_ir::NodeSpec::by_keyword(t.ident(i)?)?;
     if t.punct(i + 1) == Some(":") || t.open_paren(i).is_some() || t.in_pddl(i) {
@@ -396,4 +398,38 @@ pub fn rename(a: &Analysis, offset: usize, new_name: &str) -> Result<WorkspaceEd
             .push(TextEdit::new(range, replacement));
     }
     Ok(WorkspaceEdit::new(changes))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::workspace::Workspace;
+    use btc_lang::path::FilePath;
+    use btc_lang::project::MemoryLoader;
+
+    /// A keyword's hover lexes the item under the cursor, not the file
+    /// (a huge file's lex made every such hover cost a tenth of a second),
+    /// and its range is still in the file's terms.
+    #[test]
+    fn keyword_hover_lexes_only_its_item() {
+        let mut ws = Workspace::with_loader(Box::new(MemoryLoader::new()));
+        let path = FilePath::new("/w/a.btrules");
+        let text = "action A()\n// a comment\ntree T() { retry(2) A() }\ntree U() { A() }\n";
+        ws.open(&path, text.into(), 1);
+        ws.db.start_logging();
+        let a = Analysis::new(&ws, &path).expect("a rules file");
+        let at = text.find("retry").expect("in the text");
+        let h = hover(&a, at + 2).expect("a keyword hover");
+        let log = ws.db.take_log();
+        assert!(
+            !log.iter().any(|l| l.starts_with("rules_tokens")),
+            "{log:#?}"
+        );
+        let HoverContents::Markup(m) = h.contents else {
+            panic!("markdown")
+        };
+        assert!(m.value.contains("RetryUntilSuccessful"), "{}", m.value);
+        let start = a.range(btc_pddl::source::Span::new(0, at, at + 5));
+        assert_eq!(h.range, Some(start));
+    }
 }

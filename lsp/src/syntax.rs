@@ -170,6 +170,41 @@ impl<'a> FileSyntax<'a> {
             .get_or_init(|| Tokens::of(btc_lang::db::rules_tokens(self.db, self.file)))
     }
 
+    /// The tokens from the start of the item holding `offset` to the next
+    /// item's, with absolute spans: what a request that looks only around
+    /// the cursor needs, without lexing the whole file. An item starts at
+    /// a token outside any string or comment, so its text lexes as it does
+    /// in the file.
+    pub fn item_tokens(&self, offset: u32) -> Option<btc_lang::db::FileTokens> {
+        let i = self.item_at(offset)?;
+        let start = self.items[i].offset;
+        let end = self
+            .items
+            .get(i + 1)
+            .map_or(self.text.len(), |n| n.offset as usize);
+        let lexed = btc_lang::rules::lexer::lex(self.text.get(start as usize..end)?, 0);
+        let shift = |s: Span| Span {
+            start: s.start + start,
+            end: s.end + start,
+            ..s
+        };
+        Some(btc_lang::db::FileTokens {
+            tokens: lexed
+                .tokens
+                .into_iter()
+                .map(|(t, s)| (t, shift(s)))
+                .collect(),
+            comments: lexed
+                .comments
+                .into_iter()
+                .map(|c| Comment {
+                    span: shift(c.span),
+                    ..c
+                })
+                .collect(),
+        })
+    }
+
     /// The item holding a byte offset.
     pub fn item_at(&self, offset: u32) -> Option<usize> {
         let i = self.items.partition_point(|n| n.offset <= offset);
