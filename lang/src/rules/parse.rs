@@ -707,6 +707,7 @@ fn block_of<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>, R: ItemError<
     template
         .repeated()
         .collect::<Vec<Template>>()
+        .map(exact)
         .delimited_by(punct("{"), punct("}"))
         .recover_with(via_parser(nested_delimiters(
             Tok::Punct("{"),
@@ -721,6 +722,14 @@ fn block_of<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>, R: ItemError<
                 }]
             },
         )))
+}
+
+/// A list read by the parser, without the room its growth left (a list
+/// of one starts with room for four): an item's tree lives as long as its
+/// text is unchanged, and a huge file has tens of thousands of them.
+fn exact<T>(mut v: Vec<T>) -> Vec<T> {
+    v.shrink_to_fit();
+    v
 }
 
 fn punct<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>, R: ItemError<'t, I> + 't>(
@@ -830,6 +839,7 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>, R: ItemErr
         .separated_by(punct(","))
         .allow_trailing()
         .collect::<Vec<_>>()
+        .map(exact)
         .delimited_by(punct("("), punct(")"))
         .labelled("a port list such as `(robot: robot)`");
 
@@ -846,6 +856,7 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>, R: ItemErr
             .then(count)
             .separated_by(punct(","))
             .collect::<Vec<_>>()
+            .map(exact)
             .delimited_by(punct("("), punct(")"));
         let control_kind = control_name.then(control_args.or_not()).try_map(
             |(name, args): (ControlName, Option<Vec<(SmolStr, u32)>>), span| {
@@ -897,6 +908,7 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>, R: ItemErr
                     .separated_by(punct(","))
                     .allow_trailing()
                     .collect::<Vec<_>>()
+                    .map(exact)
                     .delimited_by(punct("("), punct(")"))
                     .or_not(),
             )
@@ -942,6 +954,7 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>, R: ItemErr
             .separated_by(punct(","))
             .allow_trailing()
             .collect::<Vec<_>>()
+            .map(exact)
             .delimited_by(punct("["), punct("]"))
             .labelled("scripts such as `[skip_if: \"done == true\"]`");
         let call = ident
@@ -949,6 +962,7 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>, R: ItemErr
                 arg.separated_by(punct(","))
                     .allow_trailing()
                     .collect::<Vec<_>>()
+                    .map(exact)
                     .delimited_by(punct("("), punct(")")),
             )
             .then(script_attrs.or_not())
@@ -1046,6 +1060,7 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>, R: ItemErr
                 .separated_by(punct(","))
                 .allow_trailing()
                 .collect::<Vec<_>>()
+                .map(exact)
                 .delimited_by(punct("{"), punct("}")),
         )
         .map_with(move |(name, entries), e| {
@@ -1077,7 +1092,7 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>, R: ItemErr
     }
     .labelled("an action name such as `move` or `pick-{op}`");
     let pattern = name_pattern
-        .then(param.repeated().collect::<Vec<_>>())
+        .then(param.repeated().collect::<Vec<_>>().map(exact))
         .delimited_by(punct("("), punct(")"))
         .map_with(move |(name, params), e| Pattern {
             name,
@@ -1139,6 +1154,7 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>, R: ItemErr
             .clone()
             .repeated()
             .collect::<Vec<_>>()
+            .map(exact)
             .then(kw("effect").ignore_then(effect).or_not())
             .delimited_by(punct("{"), punct("}"))
             .map(|(body, effect)| RuleBody::Template {
@@ -1166,7 +1182,8 @@ fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>, R: ItemErr
                     guard
                         .separated_by(punct(","))
                         .at_least(1)
-                        .collect::<Vec<_>>(),
+                        .collect::<Vec<_>>()
+                        .map(exact),
                 )
                 .or_not(),
         )
@@ -1253,7 +1270,7 @@ fn interpolate(raw: &str, file: FileId, start: usize) -> Result<StrLit, (String,
         parts.push(StrPart::Text { text });
     }
     Ok(StrLit {
-        parts,
+        parts: exact(parts),
         span: Span::new(file, start, start + raw.len() + 2),
         escapes,
     })
