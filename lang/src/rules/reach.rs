@@ -152,19 +152,21 @@ enum Constraint {
 }
 
 /// Equality classes of the rule's variables and named objects, by `==`.
-struct Classes {
-    terms: Vec<Term>,
+struct Classes<'r> {
+    terms: Vec<Term<'r>>,
     parent: Vec<usize>,
 }
 
-#[derive(Clone, Debug, PartialEq)]
-enum Term {
-    Var(String),
-    Object(Key),
+/// Borrowed from the rule: the check runs for every rule with a guard and
+/// every action it names.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Term<'r> {
+    Var(&'r str),
+    Object(&'r Key),
 }
 
-impl Classes {
-    fn id(&mut self, t: Term) -> usize {
+impl<'r> Classes<'r> {
+    fn id(&mut self, t: Term<'r>) -> usize {
         match self.terms.iter().position(|x| *x == t) {
             Some(i) => i,
             None => {
@@ -189,10 +191,10 @@ impl Classes {
     }
 }
 
-fn term(o: &Operand) -> Term {
+fn term(o: &Operand) -> Term<'_> {
     match o {
-        Operand::Var { name } => Term::Var(name.text.clone()),
-        Operand::Object { name } => Term::Object(name.key.clone()),
+        Operand::Var { name } => Term::Var(&name.text),
+        Operand::Object { name } => Term::Object(&name.key),
     }
 }
 
@@ -200,10 +202,10 @@ fn term(o: &Operand) -> Term {
 /// variables, from the parameters' types (and the types of the objects the
 /// guards name, where the domain or problem knows them).
 fn satisfiable(r: &Rule, a: &Action, ctx: DomainCtx) -> Result<(), Never> {
-    let repeats = {
-        let mut seen = std::collections::BTreeSet::new();
-        !r.pattern.params.iter().all(|p| seen.insert(&p.var.text))
-    };
+    // A pattern has a handful of parameters: pairs are cheaper than a set.
+    let params = &r.pattern.params;
+    let repeats =
+        (0..params.len()).any(|i| params[..i].iter().any(|q| q.var.text == params[i].var.text));
     if r.guards.iter().all(|g| matches!(g, Guard::InTable { .. })) && !repeats {
         return Ok(()); // nothing to contradict: the common case, kept cheap
     }
@@ -244,8 +246,8 @@ fn satisfiable(r: &Rule, a: &Action, ctx: DomainCtx) -> Result<(), Never> {
     for (x, a) in objects.iter().enumerate() {
         for b in &objects[x + 1..] {
             let (ia, ib) = (
-                classes.id(Term::Object(a.key.clone())),
-                classes.id(Term::Object(b.key.clone())),
+                classes.id(Term::Object(&a.key)),
+                classes.id(Term::Object(&b.key)),
             );
             if a.key != b.key && classes.find(ia) == classes.find(ib) {
                 return Err(Never::TwoObjects {
@@ -257,7 +259,7 @@ fn satisfiable(r: &Rule, a: &Action, ctx: DomainCtx) -> Result<(), Never> {
     }
     // What each variable is: the types of the parameters it is bound to,
     // and its type guards, in that order.
-    let mut per_var: Vec<(String, Vec<Constraint>)> = Vec::new();
+    let mut per_var: Vec<(&str, Vec<Constraint>)> = Vec::new();
     for (k, &slot) in slots.iter().enumerate() {
         let p = &r.pattern.params[slot];
         let ty = types.resolve(&a.params[k].ty, &mut Vec::new());
@@ -267,7 +269,7 @@ fn satisfiable(r: &Rule, a: &Action, ctx: DomainCtx) -> Result<(), Never> {
         };
         match per_var.iter_mut().find(|(v, _)| *v == p.var.text) {
             Some((_, cs)) => cs.push(c),
-            None => per_var.push((p.var.text.clone(), vec![c])),
+            None => per_var.push((&p.var.text, vec![c])),
         }
     }
     // A repeated variable: its parameters' types must share an object.
@@ -341,12 +343,12 @@ fn satisfiable(r: &Rule, a: &Action, ctx: DomainCtx) -> Result<(), Never> {
 }
 
 fn constraints_of<'a>(
-    per_var: &'a [(String, Vec<Constraint>)],
+    per_var: &'a [(&str, Vec<Constraint>)],
     var: &str,
 ) -> Option<&'a [Constraint]> {
     per_var
         .iter()
-        .find(|(v, _)| v == var)
+        .find(|(v, _)| *v == var)
         .map(|(_, cs)| cs.as_slice())
 }
 
