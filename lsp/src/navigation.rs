@@ -403,20 +403,14 @@ pub fn rename(a: &Analysis, offset: usize, new_name: &str) -> Result<WorkspaceEd
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::workspace::Workspace;
-    use btc_lang::path::FilePath;
-    use btc_lang::project::MemoryLoader;
 
     /// A keyword's hover lexes the item under the cursor, not the file
     /// (a huge file's lex made every such hover cost a tenth of a second),
     /// and its range is still in the file's terms.
     #[test]
     fn keyword_hover_lexes_only_its_item() {
-        let mut ws = Workspace::with_loader(Box::new(MemoryLoader::new()));
-        let path = FilePath::new("/w/a.btrules");
         let text = "action A()\n// a comment\ntree T() { retry(2) A() }\ntree U() { A() }\n";
-        ws.open(&path, text.into(), 1);
-        ws.db.start_logging();
+        let (ws, path) = crate::workspace::logging_workspace(text);
         let a = Analysis::new(&ws, &path).expect("a rules file");
         let at = text.find("retry").expect("in the text");
         let h = hover(&a, at + 2).expect("a keyword hover");

@@ -157,19 +157,13 @@ pub fn workspace_symbols(ws: &crate::workspace::Workspace, query: &str) -> Vec<S
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::workspace::Workspace;
-    use btc_lang::path::FilePath;
-    use btc_lang::project::MemoryLoader;
 
     /// Symbols read the parsed items only: the file is not lexed for them
     /// (lexing a huge file again after each edit was a large part of each
     /// symbol request); what needs the tokens still gets them.
     #[test]
     fn document_symbols_do_not_lex_the_file() {
-        let mut ws = Workspace::with_loader(Box::new(MemoryLoader::new()));
-        let path = FilePath::new("/w/a.btrules");
-        ws.open(&path, "action A()\ntree T() { A() }\n".into(), 1);
-        ws.db.start_logging();
+        let (ws, path) = crate::workspace::logging_workspace("action A()\ntree T() { A() }\n");
         let a = Analysis::new(&ws, &path).expect("a rules file");
         assert_eq!(document_symbols(&a).len(), 2);
         let log = ws.db.take_log();

@@ -296,3 +296,15 @@ impl Workspace {
         self.db.file(&full).map(|_| full)
     }
 }
+
+/// A workspace (files in memory) with `text` open as `/w/a.btrules` and
+/// the database logging the queries it runs from here on: what the tests
+/// of which work a request does start from.
+#[cfg(test)]
+pub fn logging_workspace(text: &str) -> (Workspace, FilePath) {
+    let mut ws = Workspace::with_loader(Box::new(btc_lang::project::MemoryLoader::new()));
+    let path = FilePath::new("/w/a.btrules");
+    ws.open(&path, text.into(), 1);
+    ws.db.start_logging();
+    (ws, path)
+}
