@@ -1,6 +1,7 @@
 //! Any bytes as a `.btrules` file next to the ARIAC domain and problem:
 //! parse, check every item and the file (through the salsa database, as
-//! `btc check` does), format, render every diagnostic.
+//! `btc check` does), format, render every diagnostic; and check that
+//! each item's quick parse (no error messages) agrees with its rich one.
 #![no_main]
 
 use btc_lang::db::{checked_domain, rules_diagnostics, Database};
@@ -21,4 +22,7 @@ fuzz_target!(|data: &[u8]| {
     diags.extend(checked_domain(&db, d).diagnostics.iter().cloned());
     let _ = btc_lang::rules::fmt::format(&text);
     let _ = to_terminal(&diags, &db.sources(), false);
+    if let Some(d) = btc_lang::rules::parse::quick_and_rich_disagree(&text) {
+        panic!("the quick and the rich parse disagree: {d}");
+    }
 });
