@@ -61,6 +61,7 @@ pub fn load_references(db: &mut Database, loader: &dyn FileLoader, rules: Source
         if !seen.insert(f) || !f.path(db).is_rules() {
             continue;
         }
+        crate::db::parse_ahead(db, f);
         let named: Vec<(RefKind, FilePath)> = references(db, f)
             .iter()
             .map(|r| (r.kind, r.path.clone()))

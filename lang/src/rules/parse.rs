@@ -140,6 +140,27 @@ pub fn parse_rules_with(
     file: FileId,
     mut parse_item: impl FnMut(&str) -> (std::sync::Arc<Item>, Vec<Diagnostic>),
 ) -> ParsedRules {
+    let cut = cut_rules(text, file);
+    let parsed: Vec<_> = cut
+        .items
+        .iter()
+        .map(|&(start, end)| parse_item(&text[start as usize..end as usize]))
+        .collect();
+    assemble(cut, parsed, file)
+}
+
+/// A rules file cut into items, before any item is parsed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CutRules {
+    /// Where each item starts and ends.
+    pub items: Vec<(u32, u32)>,
+    pub comments: Vec<Comment>,
+    /// Lexical diagnostics, with absolute spans.
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+/// Cuts a rules file into items (see [`Cutter`]).
+pub fn cut_rules(text: &str, file: FileId) -> CutRules {
     // Cutting needs only the item keywords' names: the other tokens'
     // names are left unallocated, and the tokens are not kept (each item
     // is lexed again to parse it).
@@ -150,17 +171,29 @@ pub fn parse_rules_with(
         &|w| ITEM_KEYWORDS.contains(&w),
         &mut |t, span| cut.token(&t, span),
     );
-    let mut diagnostics = lexed.diagnostics;
-    let chunks = cut.finish();
-    let mut items = Vec::with_capacity(chunks.len());
-    for (offset, end) in chunks {
-        let (item, diags) = parse_item(&text[offset as usize..end as usize]);
+    CutRules {
+        items: cut.finish(),
+        comments: lexed.comments,
+        diagnostics: lexed.diagnostics,
+    }
+}
+
+/// A file's parse from its cut and its items' parses, in the cut's order
+/// (spans relative to each item, as [`parse_item_text`] gives them).
+pub fn assemble(
+    cut: CutRules,
+    parsed: Vec<(std::sync::Arc<Item>, Vec<Diagnostic>)>,
+    file: FileId,
+) -> ParsedRules {
+    let mut diagnostics = cut.diagnostics;
+    let mut items = Vec::with_capacity(cut.items.len());
+    for (&(offset, _), (item, diags)) in cut.items.iter().zip(parsed) {
         diagnostics.extend(diags.into_iter().map(|d| shift(d, file, offset)));
         items.push(ItemNode { offset, item });
     }
     ParsedRules {
         items,
-        comments: lexed.comments,
+        comments: cut.comments,
         diagnostics,
     }
 }
