@@ -272,7 +272,9 @@ impl<'a> Emitter<'a> {
     /// `SHAPES` (distinct lifted conditions and effects) and `STEPS`.
     fn steps(&mut self) {
         let mut shapes: Vec<String> = Vec::new();
-        let mut index: HashMap<String, usize> = HashMap::new();
+        // Looked up once per step with the shape's text: SipHash of it was
+        // a twentieth of the module's writing.
+        let mut index: rustc_hash::FxHashMap<String, usize> = Default::default();
         // Each step's shape, by index: the rows go straight into the
         // module after the shapes, not through a second buffer as large
         // as the plan.
