@@ -58,6 +58,29 @@ impl Format {
     }
 }
 
+/// The IR as pretty JSON, written into a buffer of its exact size: its
+/// length is counted first, by a pass that writes nothing. Grown by
+/// doubling instead, a long plan's buffer ends up to twice the text's size
+/// (256 MB for 136 MB of JSON), and its pages are touched by the copies.
+fn json(ir: &TreeIr) -> String {
+    struct Count(usize);
+    impl std::io::Write for Count {
+        fn write(&mut self, b: &[u8]) -> std::io::Result<usize> {
+            self.0 += b.len();
+            Ok(b.len())
+        }
+        fn flush(&mut self) -> std::io::Result<()> {
+            Ok(())
+        }
+    }
+    let mut count = Count(0);
+    serde_json::to_writer_pretty(&mut count, ir).expect("the IR serializes");
+    let mut out = Vec::with_capacity(count.0 + 1);
+    serde_json::to_writer_pretty(&mut out, ir).expect("the IR serializes");
+    out.push(b'\n');
+    String::from_utf8(out).expect("serde_json writes UTF-8")
+}
+
 #[derive(Clone, Debug, Default)]
 pub struct Options {
     /// One flat tree instead of a `<SubTree>` per rule (BT.CPP).
@@ -79,7 +102,7 @@ pub fn emit(ir: &TreeIr, format: Format, options: &Options) -> String {
                 node_module: options.node_module.as_deref(),
             },
         ),
-        Format::Json => serde_json::to_string_pretty(ir).expect("the IR serializes") + "\n",
+        Format::Json => json(ir),
         Format::Dot => dot::emit_dot(ir),
         Format::Mermaid => dot::emit_mermaid(ir),
         Format::Commands => commands::emit(ir),

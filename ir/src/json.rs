@@ -123,12 +123,12 @@ fn upgrade_node(n: Node) -> Result<Node, String> {
                         continue;
                     }
                     p.value = match k {
-                        "formula" => PortValue::Formula(
+                        "formula" => PortValue::Formula(Box::new(
                             decode::formula(t).map_err(|m| format!("`{id}`: `{t}`: {m}"))?,
-                        ),
-                        _ => PortValue::Effect(
+                        )),
+                        _ => PortValue::Effect(Box::new(
                             decode::effect(t).map_err(|m| format!("`{id}`: `{t}`: {m}"))?,
-                        ),
+                        )),
                     };
                 }
             }

@@ -37,10 +37,13 @@ pub enum PortValue {
     Bool(bool),
     /// A port of the enclosing tree (`{name}` in BT.CPP).
     Param(String),
-    /// A ground PDDL condition (`KbHolds`' `formula`).
-    Formula(Formula),
+    /// A ground PDDL condition (`KbHolds`' `formula`). Boxed, as is the
+    /// effect: a port is almost always text, and a plan's calls hold
+    /// several ports per step, which would otherwise each be as wide as a
+    /// formula.
+    Formula(Box<Formula>),
     /// A ground PDDL effect (`KbApply`'s `effect`).
-    Effect(Effect),
+    Effect(Box<Effect>),
 }
 
 impl PortValue {

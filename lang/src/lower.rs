@@ -71,7 +71,7 @@ struct RuleTree {
 /// or parametrically (values that depend on the step become `{param}`s).
 struct Inst<'a> {
     decls: &'a Decls,
-    bindings: &'a Bindings,
+    bindings: &'a Bindings<'a>,
     captures: &'a Captures,
     /// Parametric mode: collected parameters.
     params: Option<Vec<(String, Value)>>,
@@ -199,10 +199,7 @@ fn expand_tree(decl: &TreeDecl, args: &[Arg]) -> Vec<Template> {
 
 impl Inst<'_> {
     fn lookup_var(&self, v: &str) -> Option<&str> {
-        self.bindings
-            .iter()
-            .find(|(n, _)| n == v)
-            .map(|(_, o)| o.as_str())
+        self.bindings.iter().find(|(n, _)| *n == v).map(|(_, o)| *o)
     }
 
     fn lookup_capture(&self, c: &str) -> Option<&str> {
@@ -654,10 +651,10 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
             let caps = name_matches
                 .entry((ri, g.action))
                 .or_insert_with(|| match_name(&r.pattern.name, &action.name.name))
-                .clone()?;
-            match_args(r, caps, args, &tables, &types).map(|m| (ri, *r, m))
+                .as_ref()?;
+            match_args(r, caps, args, &tables, &types).map(|b| (ri, *r, b))
         });
-        let Some((ri, rule, (captures, bindings))) = found else {
+        let Some((ri, rule, bindings)) = found else {
             let named: Vec<&&Rule> = input
                 .rules
                 .iter()
@@ -762,10 +759,13 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
             }
         };
         let rt = &rule_trees[pos].1;
+        let captures = name_matches[&(ri, g.action)]
+            .as_ref()
+            .expect("the rule's name matched this action");
         let call_inst = Inst {
             decls: input.decls,
             bindings: &bindings,
-            captures: &captures,
+            captures,
             params: None,
             tree_ports: Vec::new(),
             used_nodes: BTreeSet::new(),
@@ -867,7 +867,14 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
     let arranged = |mode: StepsMode| -> Vec<Node> {
         let nodes = std::mem::take(&mut *step_nodes.borrow_mut());
         match mode {
-            StepsMode::InOrder => nodes.into_iter().flatten().collect(),
+            StepsMode::InOrder => {
+                // Collected in place (a `Node` is as wide as an
+                // `Option<Node>`): `flatten` would copy every step's node
+                // into a second, growing buffer.
+                let mut nodes = nodes;
+                nodes.retain(Option::is_some);
+                nodes.into_iter().map(Option::unwrap).collect()
+            }
             StepsMode::Backchained => {
                 match backchain::stages(nodes, &infos, goal.as_ref(), &derived) {
                     Ok(stages) => stages,

@@ -480,7 +480,7 @@ fn hostile_ir() -> TreeIr {
         Some("kb \"holds\"\n"),
         vec![port(
             "formula",
-            PortValue::Formula(fact("at", &[OBJ_A, OBJ_B])),
+            PortValue::Formula(Box::new(fact("at", &[OBJ_A, OBJ_B]))),
         )],
     ));
     children.push(Node::Step {
@@ -514,7 +514,7 @@ fn hostile_ir() -> TreeIr {
         None,
         vec![port(
             "effect",
-            PortValue::Effect(Effect::Add(atom("done", &[OBJ_B]))),
+            PortValue::Effect(Box::new(Effect::Add(atom("done", &[OBJ_B])))),
         )],
     ));
     TreeIr {
@@ -720,7 +720,7 @@ fn failure_exits_nonzero() {
                 None,
                 vec![port(
                     "effect",
-                    PortValue::Effect(Effect::Delete(atom("at", &[OBJ_A, OBJ_B]))),
+                    PortValue::Effect(Box::new(Effect::Delete(atom("at", &[OBJ_A, OBJ_B])))),
                 )],
             ),
             leaf(

@@ -19,7 +19,7 @@ pub mod names;
 
 use btc_ir::vocab::{NodeSpec, PyTrees};
 use btc_ir::Count;
-use btc_ir::{Label, LeafKind, Node, NodeModel, Port, StepInfo, TreeIr};
+use btc_ir::{Label, LabelPart, LeafKind, Node, NodeModel, Port, StepInfo, TreeIr};
 use btc_pddl::logic::InitFact;
 use names::{is_plain_kwarg, RESERVED};
 pub use names::{push_py_str, py_ident, py_str, Names};
@@ -272,8 +272,13 @@ impl<'a> Emitter<'a> {
     /// `SHAPES` (distinct lifted conditions and effects) and `STEPS`.
     fn steps(&mut self) {
         let mut shapes: Vec<String> = Vec::new();
-        let mut index: HashMap<String, usize> = HashMap::new();
-        let mut rows = String::with_capacity(64 * self.ir.steps.len());
+        // Looked up once per step with the shape's text: SipHash of it was
+        // a twentieth of the module's writing.
+        let mut index: rustc_hash::FxHashMap<String, usize> = Default::default();
+        // Each step's shape, by index: the rows go straight into the
+        // module after the shapes, not through a second buffer as large
+        // as the plan.
+        let mut of_step: Vec<usize> = Vec::with_capacity(self.ir.steps.len());
         let mut buf = String::new();
         for s in &self.ir.steps {
             buf.clear();
@@ -286,7 +291,7 @@ impl<'a> Emitter<'a> {
                     shapes.len() - 1
                 }
             };
-            row_of(s, k, &mut rows);
+            of_step.push(k);
         }
         let o = &mut self.out;
         o.push_str(
@@ -302,7 +307,9 @@ impl<'a> Emitter<'a> {
             o.push_str(",\n");
         }
         o.push_str(")\n\nSTEPS = (\n");
-        o.push_str(&rows);
+        for (s, k) in self.ir.steps.iter().zip(of_step) {
+            row_of(s, k, o);
+        }
         o.push_str(")\n\nPLAN = Plan(SHAPES, STEPS)\n");
     }
 
@@ -411,7 +418,9 @@ impl<'a> Emitter<'a> {
                 ..
             } => {
                 let tag = pytrees_code(control.spec());
-                let _ = write!(o, "(\"{tag}\", {}, ", opt_name(name));
+                let _ = write!(o, "(\"{tag}\", ");
+                push_opt_name(o, name);
+                o.push_str(", ");
                 for v in control.params() {
                     let _ = write!(o, "{v}, ");
                 }
@@ -439,7 +448,9 @@ impl<'a> Emitter<'a> {
                     Some(Count::Param { param }) => format!("(\"$\", {})", py_str(param)),
                     None => "0".into(),
                 };
-                let _ = write!(o, "(\"D\", \"{kind}\", {arg}, {}, ", opt_name(name));
+                let _ = write!(o, "(\"D\", \"{kind}\", {arg}, ");
+                push_opt_name(o, name);
+                o.push_str(", ");
                 self.node(child, o, indent);
                 o.push(')');
             }
@@ -447,7 +458,9 @@ impl<'a> Emitter<'a> {
                 id, name, ports, ..
             } => {
                 let class = self.classes.get(id.as_str()).map_or(0, |c| c.index);
-                let _ = write!(o, "(\"L\", {class}, {}, ", opt_name(name));
+                let _ = write!(o, "(\"L\", {class}, ");
+                push_opt_name(o, name);
+                o.push_str(", ");
                 ports_tuple(ports, o);
                 o.push(')');
             }
@@ -544,9 +557,16 @@ fn push_indent(o: &mut String, levels: usize) {
 }
 
 /// A node's name; the module fills a tree's parameters in at each call.
-fn opt_name(name: &Option<Label>) -> String {
-    name.as_ref()
-        .map_or_else(|| "None".into(), |n| py_str(&n.braced()))
+/// Written in place: most names are one piece of text (a step's guard
+/// names one per step), which needs no braced copy.
+fn push_opt_name(o: &mut String, name: &Option<Label>) {
+    let Some(n) = name else {
+        return o.push_str("None");
+    };
+    match n.parts.as_slice() {
+        [LabelPart::Text(t)] => push_py_str(o, t),
+        _ => push_py_str(o, &n.braced()),
+    }
 }
 
 /// `(("port", value), ...)`

@@ -17,7 +17,7 @@ pub(super) fn kb_holds(f: Formula, name: Option<String>) -> Node {
         name: name.map(Label::text),
         ports: vec![Port {
             name: "formula".into(),
-            value: PortValue::Formula(f),
+            value: PortValue::Formula(Box::new(f)),
         }],
     }
 }

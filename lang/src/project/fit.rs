@@ -82,34 +82,10 @@ pub fn plan_validation(db: &dyn Db, job: CompileJob) -> Vec<Diagnostic> {
     if has_errors(&super::report::flatten(super::report::job_report(db, job))) {
         return Vec::new();
     }
-    let (Some(d), Some(p)) = (job_domain(db, job), job_problem(db, job)) else {
+    let Some(p) = job_problem(db, job) else {
         return Vec::new();
     };
-    let valid_for = |problem: SourceFile| -> Option<Vec<Diagnostic>> {
-        let cd = checked_domain(db, d);
-        let cp = checked_problem(db, ProblemOf::new(db, problem, d));
-        let (domain, prob) = (cd.domain.as_ref()?, cp.problem.as_ref()?);
-        let tp = if problem == p {
-            typed_plan(db, job).clone()
-        } else {
-            let (steps, diags) =
-                btc_pddl::plan::type_plan(&typed_plan(db, job).plan, domain, &cd.index, &cp.index);
-            if has_errors(&diags) {
-                return None;
-            }
-            crate::db::TypedPlan {
-                plan: typed_plan(db, job).plan.clone(),
-                steps,
-                diagnostics: diags,
-            }
-        };
-        let v = btc_pddl::validate::validate_plan(
-            domain, prob, &cd.index, &cp.index, &tp.plan, &tp.steps,
-        );
-        // A world the logic layer cannot build is reported by the checks.
-        v.ok().map(|v| v.diagnostics)
-    };
-    let Some(mut diags) = valid_for(p) else {
+    let Some(mut diags) = replay_on_problem(db, job).clone() else {
         return Vec::new();
     };
     if diags.is_empty() {
@@ -117,7 +93,7 @@ pub fn plan_validation(db: &dyn Db, job: CompileJob) -> Vec<Diagnostic> {
     }
     let valid: Vec<String> = neighbours(db, job)
         .into_iter()
-        .filter(|n| valid_for(*n).is_some_and(|d| d.is_empty()))
+        .filter(|n| replay(db, job, *n).is_some_and(|d| d.is_empty()))
         .map(|n| n.path(db).to_string())
         .collect();
     let advice = match valid.as_slice() {
@@ -141,6 +117,42 @@ pub fn plan_validation(db: &dyn Db, job: CompileJob) -> Vec<Diagnostic> {
         });
     }
     diags
+}
+
+/// The plan replayed on the job's own problem. A query of its own: loading
+/// the problems beside the plan changes the workspace, which runs
+/// [`plan_validation`] again, and a long plan's replay should not run
+/// again with it.
+#[salsa::tracked(returns(ref))]
+fn replay_on_problem(db: &dyn Db, job: CompileJob) -> Option<Vec<Diagnostic>> {
+    replay(db, job, job_problem(db, job)?)
+}
+
+/// The plan replayed on `problem` from its initial state (its steps typed
+/// again for a problem other than the job's); `None` when the plan or the
+/// world cannot be built for it.
+fn replay(db: &dyn Db, job: CompileJob, problem: SourceFile) -> Option<Vec<Diagnostic>> {
+    let d = job_domain(db, job)?;
+    let cd = checked_domain(db, d);
+    let cp = checked_problem(db, ProblemOf::new(db, problem, d));
+    let (domain, prob) = (cd.domain.as_ref()?, cp.problem.as_ref()?);
+    let tp = typed_plan(db, job);
+    // The job's steps are borrowed, never copied: a copy of a long plan
+    // cost more than replaying it.
+    let retyped;
+    let steps = if Some(problem) == job_problem(db, job) {
+        &tp.steps
+    } else {
+        let (steps, diags) = btc_pddl::plan::type_plan(&tp.plan, domain, &cd.index, &cp.index);
+        if has_errors(&diags) {
+            return None;
+        }
+        retyped = steps;
+        &retyped
+    };
+    let v = btc_pddl::validate::validate_plan(domain, prob, &cd.index, &cp.index, &tp.plan, steps);
+    // A world the logic layer cannot build is reported by the checks.
+    v.ok().map(|v| v.diagnostics)
 }
 
 /// Whether looking at the problems beside the plan could say more: the

@@ -106,8 +106,9 @@ pub fn bind_params(pattern: &Pattern, argc: usize) -> Option<Vec<usize>> {
     Some(out)
 }
 
-/// Variable bindings of a matched step: variable name to object name.
-pub type Bindings = Vec<(String, String)>;
+/// Variable bindings of a matched step: variable name to object name,
+/// borrowed from the rule and the step (a plan binds a few per step).
+pub type Bindings<'a> = Vec<(&'a str, &'a str)>;
 
 /// What a guard needs to know about objects.
 pub trait ObjectTypes {
@@ -117,34 +118,36 @@ pub trait ObjectTypes {
 
 /// Matches a step (action name and arguments, folded) against a rule:
 /// name, argument count, repeated variables, guards.
-pub fn match_step(
-    rule: &Rule,
+pub fn match_step<'a>(
+    rule: &'a Rule,
     action: &str,
-    args: &[String],
+    args: &'a [impl AsRef<str>],
     tables: &dyn Fn(&str) -> Option<TableDecl>,
     types: &dyn ObjectTypes,
-) -> Option<(Captures, Bindings)> {
+) -> Option<(Captures, Bindings<'a>)> {
     let caps = match_name(&rule.pattern.name, action)?;
-    match_args(rule, caps, args, tables, types)
+    let bindings = match_args(rule, &caps, args, tables, types)?;
+    Some((caps, bindings))
 }
 
-/// The rest of [`match_step`] once the name matched with `caps` (callers
-/// that see the same action name often match names once).
-pub fn match_args(
-    rule: &Rule,
-    caps: Captures,
-    args: &[String],
+/// The rest of [`match_step`] once the name matched with `caps`: the
+/// bindings (callers that see the same action name often match names once,
+/// and keep the captures: they are not copied per step).
+pub fn match_args<'a>(
+    rule: &'a Rule,
+    caps: &Captures,
+    args: &'a [impl AsRef<str>],
     tables: &dyn Fn(&str) -> Option<TableDecl>,
     types: &dyn ObjectTypes,
-) -> Option<(Captures, Bindings)> {
+) -> Option<Bindings<'a>> {
     let slots = bind_params(&rule.pattern, args.len())?;
     let mut bindings: Bindings = Vec::with_capacity(args.len());
     for (arg, &slot) in args.iter().zip(&slots) {
-        let var = &rule.pattern.params[slot].var.text;
-        match bindings.iter().find(|(v, _)| v == var) {
-            Some((_, bound)) if bound != arg => return None, // repeated variable: equality
+        let (var, arg) = (rule.pattern.params[slot].var.text.as_str(), arg.as_ref());
+        match bindings.iter().find(|(v, _)| *v == var) {
+            Some((_, bound)) if *bound != arg => return None, // repeated variable: equality
             Some(_) => {}
-            None => bindings.push((var.clone(), arg.clone())),
+            None => bindings.push((var, arg)),
         }
     }
     fn value<'a>(o: &'a Operand, bindings: &'a Bindings) -> Option<&'a str> {
@@ -152,7 +155,7 @@ pub fn match_args(
             Operand::Var { name } => bindings
                 .iter()
                 .find(|(n, _)| *n == name.text)
-                .map(|(_, o)| o.as_str()),
+                .map(|(_, o)| *o),
             Operand::Object { name } => Some(name.key.as_str()),
         }
     }
@@ -180,7 +183,7 @@ pub fn match_args(
             return None;
         }
     }
-    Some((caps, bindings))
+    Some(bindings)
 }
 
 #[cfg(test)]
@@ -204,9 +207,8 @@ mod tests {
         }
     }
 
-    fn m(r: &Rule, action: &str, args: &[&str]) -> Option<(Captures, Bindings)> {
-        let args: Vec<String> = args.iter().map(|s| s.to_string()).collect();
-        match_step(r, action, &args, &|_| None, &AllTypes)
+    fn m<'a>(r: &'a Rule, action: &str, args: &'a [&'a str]) -> Option<(Captures, Bindings<'a>)> {
+        match_step(r, action, args, &|_| None, &AllTypes)
     }
 
     #[test]

@@ -231,9 +231,11 @@ impl Terms for Formula {
                 let (vs, body) = under(vs, f, bound, |f, b| body.fold_terms(f, b));
                 Formula::Forall(vs, Box::new(body))
             }
-            Formula::Compare(op, l, r) => {
-                Formula::Compare(*op, l.fold_terms(f, bound), r.fold_terms(f, bound))
-            }
+            Formula::Compare(op, l, r) => Formula::Compare(
+                *op,
+                Box::new(l.fold_terms(f, bound)),
+                Box::new(r.fold_terms(f, bound)),
+            ),
         }
     }
 }
@@ -248,12 +250,15 @@ impl Terms for Effect {
                 let (vs, body) = under(vs, f, bound, |f, b| body.fold_terms(f, b));
                 Effect::Forall(vs, Box::new(body))
             }
-            Effect::When(c, body) => {
-                Effect::When(c.fold_terms(f, bound), Box::new(body.fold_terms(f, bound)))
-            }
-            Effect::Numeric(op, fl, v) => {
-                Effect::Numeric(*op, fl.fold_terms(f, bound), v.fold_terms(f, bound))
-            }
+            Effect::When(c, body) => Effect::When(
+                Box::new(c.fold_terms(f, bound)),
+                Box::new(body.fold_terms(f, bound)),
+            ),
+            Effect::Numeric(op, fl, v) => Effect::Numeric(
+                *op,
+                fl.fold_terms(f, bound),
+                Box::new(v.fold_terms(f, bound)),
+            ),
         }
     }
 }

@@ -97,7 +97,9 @@ pub enum Formula {
     Imply(Box<Formula>, Box<Formula>),
     Exists(Vec<TypedVar>, Box<Formula>),
     Forall(Vec<TypedVar>, Box<Formula>),
-    Compare(Comparison, NumExpr, NumExpr),
+    /// Boxed operands, as in [`Effect`]'s wide variants: every `and` holds
+    /// its parts inline, and comparisons are rare next to atoms.
+    Compare(Comparison, Box<NumExpr>, Box<NumExpr>),
 }
 
 impl Formula {
@@ -172,7 +174,11 @@ impl Formula {
             ),
             ast::Formula::Compare {
                 op, left, right, ..
-            } => Formula::Compare(*op, NumExpr::from_ast(left), NumExpr::from_ast(right)),
+            } => Formula::Compare(
+                *op,
+                Box::new(NumExpr::from_ast(left)),
+                Box::new(NumExpr::from_ast(right)),
+            ),
         }
     }
 }
@@ -215,8 +221,8 @@ pub enum Effect {
     Delete(Atom),
     And(Vec<Effect>),
     Forall(Vec<TypedVar>, Box<Effect>),
-    When(Formula, Box<Effect>),
-    Numeric(AssignOp, Atom, NumExpr),
+    When(Box<Formula>, Box<Effect>),
+    Numeric(AssignOp, Atom, Box<NumExpr>),
 }
 
 impl Effect {
@@ -286,12 +292,16 @@ impl Effect {
             ast::Effect::When {
                 condition, body, ..
             } => Effect::When(
-                Formula::from_ast(condition),
+                Box::new(Formula::from_ast(condition)),
                 Box::new(Effect::from_ast(body)),
             ),
             ast::Effect::Numeric {
                 op, fluent, value, ..
-            } => Effect::Numeric(*op, Atom::from_ast(fluent), NumExpr::from_ast(value)),
+            } => Effect::Numeric(
+                *op,
+                Atom::from_ast(fluent),
+                Box::new(NumExpr::from_ast(value)),
+            ),
         }
     }
 }
