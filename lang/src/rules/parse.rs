@@ -613,31 +613,19 @@ fn parse_rich<'t>(
 #[doc(hidden)]
 pub fn quick_and_rich_disagree(text: &str) -> Option<String> {
     let parsers = cached_item_parsers(0);
-    let mut found = None;
-    parse_rules_with(text, 0, |item| {
+    cut_rules(text, 0).items.iter().find_map(|&(start, end)| {
+        let item = &text[start as usize..end as usize];
         let mut lexed = lex(item, 0);
-        if let Some(input) = prepare(&mut lexed.tokens, item, 0, 0, &mut Vec::new()) {
-            let eoi = SimpleSpan::from(item.len()..item.len());
-            let quick = parse_quick(&parsers, &input, eoi);
-            let (rich, errors) = parse_rich(&parsers, &input, eoi);
-            let agree = match &quick {
-                None => !errors.is_empty(),
-                Some(_) => errors.is_empty() && quick == rich,
-            };
-            if !agree && found.is_none() {
-                found = Some(format!(
-                    "{item}\nquick: {quick:?}\nrich: {rich:?} {errors:?}"
-                ));
-            }
-        }
-        (
-            std::sync::Arc::new(Item::Error {
-                span: Span::new(0, 0, 0),
-            }),
-            Vec::new(),
-        )
-    });
-    found
+        let input = prepare(&mut lexed.tokens, item, 0, 0, &mut Vec::new())?;
+        let eoi = SimpleSpan::from(item.len()..item.len());
+        let quick = parse_quick(&parsers, &input, eoi);
+        let (rich, errors) = parse_rich(&parsers, &input, eoi);
+        let agree = match &quick {
+            None => !errors.is_empty(),
+            Some(_) => errors.is_empty() && quick == rich,
+        };
+        (!agree).then(|| format!("{item}\nquick: {quick:?}\nrich: {rich:?} {errors:?}"))
+    })
 }
 
 fn rich_to_diagnostic(e: &Rich<'_, Tok, SimpleSpan>, file: FileId) -> Diagnostic {
@@ -690,7 +678,6 @@ impl<'t, I: Input<'t, Span = SimpleSpan>> ItemError<'t, I> for EmptyErr {
     }
 }
 
-type Err<R> = extra::Err<R>;
 type RichErr<'t> = Rich<'t, Tok, SimpleSpan>;
 
 /// What the item parser reads: an item's tokens with their relative spans.
@@ -714,7 +701,7 @@ struct QuickItemParser {
 }
 
 impl Cached for RichItemParser {
-    type Parser<'t> = Boxed<'t, 't, ItemInput<'t>, Item, Err<RichErr<'t>>>;
+    type Parser<'t> = Boxed<'t, 't, ItemInput<'t>, Item, extra::Err<RichErr<'t>>>;
 
     fn make_parser<'t>(self) -> Self::Parser<'t> {
         item_parser(self.file).boxed()
@@ -722,7 +709,7 @@ impl Cached for RichItemParser {
 }
 
 impl Cached for QuickItemParser {
-    type Parser<'t> = Boxed<'t, 't, ItemInput<'t>, Item, Err<EmptyErr>>;
+    type Parser<'t> = Boxed<'t, 't, ItemInput<'t>, Item, extra::Err<EmptyErr>>;
 
     fn make_parser<'t>(self) -> Self::Parser<'t> {
         item_parser(self.file).boxed()
@@ -759,7 +746,7 @@ fn cached_item_parsers(file: FileId) -> Rc<ItemParsers> {
 
 fn kw<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>, R: ItemError<'t, I> + 't>(
     word: &'static str,
-) -> impl Parser<'t, I, (), Err<R>> + Clone {
+) -> impl Parser<'t, I, (), extra::Err<R>> + Clone {
     just(Tok::Ident(SmolStr::new_static(word)))
         .ignored()
         .labelled(word)
@@ -768,9 +755,9 @@ fn kw<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>, R: ItemError<'t, I>
 /// Templates in braces; a block that does not parse becomes one error
 /// node and parsing goes on after its closing brace.
 fn block_of<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>, R: ItemError<'t, I> + 't>(
-    template: impl Parser<'t, I, Template, Err<R>> + Clone,
+    template: impl Parser<'t, I, Template, extra::Err<R>> + Clone,
     file: FileId,
-) -> impl Parser<'t, I, Vec<Template>, Err<R>> + Clone {
+) -> impl Parser<'t, I, Vec<Template>, extra::Err<R>> + Clone {
     template
         .repeated()
         .collect::<Vec<Template>>()
@@ -801,13 +788,13 @@ fn exact<T>(mut v: Vec<T>) -> Vec<T> {
 
 fn punct<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>, R: ItemError<'t, I> + 't>(
     p: &'static str,
-) -> impl Parser<'t, I, (), Err<R>> + Clone {
+) -> impl Parser<'t, I, (), extra::Err<R>> + Clone {
     just(Tok::Punct(p)).ignored()
 }
 
 fn item_parser<'t, I: ValueInput<'t, Token = Tok, Span = SimpleSpan>, R: ItemError<'t, I> + 't>(
     file: FileId,
-) -> impl Parser<'t, I, Item, Err<R>> {
+) -> impl Parser<'t, I, Item, extra::Err<R>> {
     let sp = move |s: SimpleSpan| Span::new(file, s.start, s.end);
     let ident = select! { Tok::Ident(s) => s }
         .map_with(move |text: SmolStr, e| Ident::new(text.into(), sp(e.span())))
