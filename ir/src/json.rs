@@ -7,6 +7,7 @@ use crate::{Node, NodeModel, PortValue, StepInfo, TreeDef, TreeIr, IR_VERSION};
 use btc_pddl::logic::decode;
 use btc_pddl::world::WorldModel;
 use serde::Deserialize;
+use std::sync::Arc;
 
 /// A JSON IR file as read.
 #[derive(Clone, Debug, PartialEq)]
@@ -123,10 +124,10 @@ fn upgrade_node(n: Node) -> Result<Node, String> {
                         continue;
                     }
                     p.value = match k {
-                        "formula" => PortValue::Formula(Box::new(
+                        "formula" => PortValue::Formula(Arc::new(
                             decode::formula(t).map_err(|m| format!("`{id}`: `{t}`: {m}"))?,
                         )),
-                        _ => PortValue::Effect(Box::new(
+                        _ => PortValue::Effect(Arc::new(
                             decode::effect(t).map_err(|m| format!("`{id}`: `{t}`: {m}"))?,
                         )),
                     };

@@ -13,6 +13,7 @@ use btc_pddl::logic::{Effect, Formula};
 use btc_pddl::world::WorldModel;
 use serde::{Deserialize, Serialize};
 use std::collections::HashSet;
+use std::sync::Arc;
 
 pub mod json;
 mod label;
@@ -37,13 +38,14 @@ pub enum PortValue {
     Bool(bool),
     /// A port of the enclosing tree (`{name}` in BT.CPP).
     Param(String),
-    /// A ground PDDL condition (`KbHolds`' `formula`). Boxed, as is the
-    /// effect: a port is almost always text, and a plan's calls hold
+    /// A ground PDDL condition (`KbHolds`' `formula`). Behind a pointer, as
+    /// is the effect: a port is almost always text, and a plan's calls hold
     /// several ports per step, which would otherwise each be as wide as a
-    /// formula.
-    Formula(Box<Formula>),
+    /// formula. Shared: steps that repeat a ground action share its
+    /// conditions (see [`StepInfo`]).
+    Formula(Arc<Formula>),
     /// A ground PDDL effect (`KbApply`'s `effect`).
-    Effect(Box<Effect>),
+    Effect(Arc<Effect>),
 }
 
 impl PortValue {
@@ -63,18 +65,32 @@ impl PortValue {
 
 /// Floats always with a decimal point (`1.0`, not `1`).
 pub fn format_float(f: f64) -> String {
+    let mut s = String::new();
+    push_float(&mut s, f);
+    s
+}
+
+/// [`format_float`] appended to `out`: a long plan writes a duration per
+/// step, and a `String` for each was a tenth of its emit.
+pub fn push_float(out: &mut String, f: f64) {
     if f.fract() == 0.0 && f.is_finite() && f.abs() < 1e15 {
         // As `{f:.1}` writes it, through integer formatting: `{:.1}` takes
-        // the exact (big-number) path, a tenth of a long plan's emit.
-        let sign = if f.is_sign_negative() && f == 0.0 {
-            "-"
-        } else {
-            ""
-        };
-        format!("{sign}{}.0", f as i64)
+        // the exact (big-number) path.
+        if f.is_sign_negative() && f == 0.0 {
+            out.push('-');
+        }
+        push_int(out, f as i64);
+        out.push_str(".0");
     } else {
-        format!("{f}")
+        use std::fmt::Write;
+        let _ = write!(out, "{f}");
     }
+}
+
+/// An integer appended to `out` in decimal, as `{n}` writes it but
+/// without the formatting machinery (numbers are most of a plan's rows).
+pub fn push_int(out: &mut String, n: impl itoa::Integer) {
+    out.push_str(itoa::Buffer::new().format(n));
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -215,12 +231,14 @@ pub struct StepInfo {
     pub skipped: bool,
     /// Ground conditions and effects, by when they apply. The effects are
     /// the step's: its rule's `effect` when the rule gives one, else the
-    /// PDDL action's.
-    pub pre_start: Option<Formula>,
-    pub pre_over_all: Option<Formula>,
-    pub pre_end: Option<Formula>,
-    pub eff_start: Option<Effect>,
-    pub eff_end: Option<Effect>,
+    /// PDDL action's. Shared between the steps that repeat a ground action
+    /// (plans repeat them a lot: a long plan would otherwise hold one copy
+    /// of each tree per step); in JSON each step writes its own.
+    pub pre_start: Option<Arc<Formula>>,
+    pub pre_over_all: Option<Arc<Formula>>,
+    pub pre_end: Option<Arc<Formula>>,
+    pub eff_start: Option<Arc<Effect>>,
+    pub eff_end: Option<Arc<Effect>>,
     /// Steps that must finish before this one (`steps parallel`).
     pub after: Vec<usize>,
 }

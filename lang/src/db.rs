@@ -1110,6 +1110,43 @@ mod compile_tests {
             }
         }
     }
+
+    /// A long plan repeats few ground actions: lowering grounds each once
+    /// and its steps share the result, so the IR's logic grows with the
+    /// distinct ground actions, not with the steps.
+    #[test]
+    fn repeated_ground_actions_share_their_logic() {
+        use std::collections::{HashMap, HashSet};
+        use std::sync::Arc;
+        let mut db = Database::new();
+        let job = example_job(&mut db, "examples/p3_assembler");
+        job.plan(&db)
+            .set_text(&mut db)
+            .to(btc_testkit::long_p3_plan(600));
+        let ir = compile(&db, job).as_ref().expect("the long plan compiles");
+        assert_eq!(ir.steps.len(), 600);
+        fn same<T>(a: &Option<Arc<T>>, b: &Option<Arc<T>>) -> bool {
+            match (a, b) {
+                (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+                (None, None) => true,
+                _ => false,
+            }
+        }
+        let mut first: HashMap<(&str, &[String]), &btc_ir::StepInfo> = HashMap::new();
+        let mut effects = HashSet::new();
+        for s in &ir.steps {
+            let f = first
+                .entry((s.action.as_str(), s.args.as_slice()))
+                .or_insert(s);
+            assert!(same(&f.pre_start, &s.pre_start) && same(&f.pre_over_all, &s.pre_over_all));
+            assert!(same(&f.pre_end, &s.pre_end) && same(&f.eff_start, &s.eff_start));
+            assert!(same(&f.eff_end, &s.eff_end));
+            effects.extend(s.eff_end.as_ref().map(Arc::as_ptr));
+        }
+        // Every P3 action but WAIT changes something at its end.
+        assert_eq!(effects.len(), first.len() - 1);
+        assert!(first.len() < 20, "{} distinct ground actions", first.len());
+    }
 }
 
 #[cfg(test)]

@@ -17,12 +17,13 @@ use btc_pddl::logic::{self, Formula, Name};
 use btc_pddl::plan::{GroundStep, Plan};
 use btc_pddl::world::WorldModel;
 use std::collections::{BTreeMap, BTreeSet};
+use std::sync::Arc;
 
 mod action;
 mod arrange;
 mod backchain;
 
-use action::{ActionLogic, RuleEffect};
+use action::{Grounder, RuleEffect};
 use arrange::kb_holds;
 
 pub struct LowerInput<'a> {
@@ -599,7 +600,8 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
         pix: input.pix,
     };
     let tables = |name: &str| input.decls.tables.get(name).cloned();
-    let mut actions: BTreeMap<usize, ActionLogic> = BTreeMap::new();
+    let mut grounder = Grounder::default();
+    let mut guard_names: rustc_hash::FxHashMap<usize, Label> = Default::default();
     let mut rule_effects: BTreeMap<usize, RuleEffect> = BTreeMap::new();
     let mut rule_trees: Vec<(usize, RuleTree)> = Vec::new(); // by rule index
     let mut taken = BTreeSet::new();
@@ -620,20 +622,16 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
     for (k, g) in input.steps.iter().enumerate() {
         let step = &input.plan.steps[g.step];
         let action = &input.domain.actions[g.action];
-        let objects: Vec<Name> = g
-            .args
-            .iter()
-            .map(|&o| object_names[o as usize].clone())
-            .collect();
-        let ground = actions
-            .entry(g.action)
-            .or_insert_with(|| ActionLogic::new(action))
-            .ground(&objects);
+        let ground = grounder.ground(input.domain, g.action, &g.args, &object_names);
         let mut info = StepInfo {
             index: k,
             line: step.line,
             action: action.name.name.clone(),
-            args: objects.iter().map(|o| o.to_string()).collect(),
+            args: g
+                .args
+                .iter()
+                .map(|&o| object_names[o as usize].to_string())
+                .collect(),
             time: step.time,
             duration: step.duration,
             rule: None,
@@ -703,7 +701,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
             match lifted.ground(&bindings) {
                 Ok(e) => {
                     info.eff_start = None;
-                    info.eff_end = e;
+                    info.eff_end = e.map(Arc::new);
                 }
                 Err(var) => {
                     diags.push(
@@ -834,10 +832,16 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
             ports,
         };
         if let Some(over) = &info.pre_over_all {
+            // Steps that repeat a ground action share its condition, and
+            // their guard's name with it.
+            let name = guard_names
+                .entry(Arc::as_ptr(over) as usize)
+                .or_insert_with(|| Label::from(format!("while {over}")))
+                .clone();
             child = Node::Control {
                 scripts: Default::default(),
                 control: ControlKind::ReactiveSequence,
-                name: Some(format!("while {over}").into()),
+                name: Some(name),
                 children: vec![kb_holds(over.clone(), None), child],
             };
         }

@@ -387,12 +387,12 @@ fn step(index: usize, args: &[&str], eff_end: Effect) -> StepInfo {
         duration: Some(1.0),
         rule: Some("rule \"\"\"x".into()),
         skipped: false,
-        pre_start: Some(fact("at", &args[..2])),
+        pre_start: Some(fact("at", &args[..2]).into()),
         pre_over_all: None,
         pre_end: None,
         // Step 2 starts by deleting the fact step 1 added.
-        eff_start: (index == 1).then(|| Effect::Delete(atom("at", &args[..2]))),
-        eff_end: Some(eff_end),
+        eff_start: (index == 1).then(|| Effect::Delete(atom("at", &args[..2])).into()),
+        eff_end: Some(eff_end.into()),
         after: Vec::new(),
     }
 }
@@ -480,7 +480,7 @@ fn hostile_ir() -> TreeIr {
         Some("kb \"holds\"\n"),
         vec![port(
             "formula",
-            PortValue::Formula(Box::new(fact("at", &[OBJ_A, OBJ_B]))),
+            PortValue::Formula(std::sync::Arc::new(fact("at", &[OBJ_A, OBJ_B]))),
         )],
     ));
     children.push(Node::Step {
@@ -514,7 +514,7 @@ fn hostile_ir() -> TreeIr {
         None,
         vec![port(
             "effect",
-            PortValue::Effect(Box::new(Effect::Add(atom("done", &[OBJ_B])))),
+            PortValue::Effect(std::sync::Arc::new(Effect::Add(atom("done", &[OBJ_B])))),
         )],
     ));
     TreeIr {
@@ -720,7 +720,10 @@ fn failure_exits_nonzero() {
                 None,
                 vec![port(
                     "effect",
-                    PortValue::Effect(Box::new(Effect::Delete(atom("at", &[OBJ_A, OBJ_B])))),
+                    PortValue::Effect(std::sync::Arc::new(Effect::Delete(atom(
+                        "at",
+                        &[OBJ_A, OBJ_B],
+                    )))),
                 )],
             ),
             leaf(

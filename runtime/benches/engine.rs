@@ -155,7 +155,9 @@ fn reactive_kb_monitor_over_100_actions(b: Bencher) {
             kind: None,
             ports: vec![(
                 "formula".into(),
-                PortValue::Formula(Box::new(decode::formula("(at r1 bin1)").unwrap())),
+                PortValue::Formula(std::sync::Arc::new(
+                    decode::formula("(at r1 bin1)").unwrap(),
+                )),
             )],
         },
         Vec::new(),

@@ -479,10 +479,10 @@ fn kb_ports(e: &Elem, ports: &mut [(String, PortValue)]) -> Result<(), LoadError
     for (k, v) in ports {
         let PortValue::Text(t) = v else { continue };
         *v = match (e.name.as_str(), k.as_str()) {
-            ("KbHolds", "formula") => PortValue::Formula(Box::new(
+            ("KbHolds", "formula") => PortValue::Formula(std::sync::Arc::new(
                 decode::formula(t).map_err(|m| bad_pddl(e, k, t, "a PDDL condition", &m))?,
             )),
-            ("KbApply", "effect") => PortValue::Effect(Box::new(
+            ("KbApply", "effect") => PortValue::Effect(std::sync::Arc::new(
                 decode::effect(t).map_err(|m| bad_pddl(e, k, t, "a PDDL effect", &m))?,
             )),
             _ => continue,

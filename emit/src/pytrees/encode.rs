@@ -9,7 +9,7 @@
 //! written, whichever argument an object is taken for.
 
 use super::names::{push_py_str, py_str};
-use btc_ir::{format_float, PortValue};
+use btc_ir::{push_float, push_int, PortValue};
 use btc_pddl::logic::TypedVar;
 use btc_pddl::logic::{AssignOp, Atom, Comparison, Effect, Formula, NumExpr, NumOp, Term};
 use std::fmt::Write;
@@ -234,17 +234,23 @@ pub fn ground_atom(a: &Atom) -> String {
 }
 
 pub fn py_float(f: f64) -> String {
+    let mut s = String::new();
+    push_py_float(&mut s, f);
+    s
+}
+
+/// [`py_float`] appended to `out` (a duration per step of a long plan).
+pub fn push_py_float(out: &mut String, f: f64) {
     if f.is_nan() {
-        "float(\"nan\")".into()
+        out.push_str("float(\"nan\")");
     } else if f.is_infinite() {
-        if f > 0.0 {
+        out.push_str(if f > 0.0 {
             "float(\"inf\")"
         } else {
             "float(\"-inf\")"
-        }
-        .into()
+        });
     } else {
-        format_float(f)
+        push_float(out, f);
     }
 }
 
@@ -253,10 +259,8 @@ pub fn py_float(f: f64) -> String {
 pub fn port_value(v: &PortValue, out: &mut String) {
     match v {
         PortValue::Text(s) => push_py_str(out, s),
-        PortValue::Int(n) => {
-            let _ = write!(out, "{n}");
-        }
-        PortValue::Float(f) => out.push_str(&py_float(*f)),
+        PortValue::Int(n) => push_int(out, *n),
+        PortValue::Float(f) => push_py_float(out, *f),
         PortValue::Bool(b) => out.push_str(if *b { "True" } else { "False" }),
         PortValue::Param(p) => {
             let _ = write!(out, "(\"$\", {})", py_str(p));

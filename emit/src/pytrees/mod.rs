@@ -19,12 +19,15 @@ pub mod names;
 
 use btc_ir::vocab::{NodeSpec, PyTrees};
 use btc_ir::Count;
-use btc_ir::{Label, LabelPart, LeafKind, Node, NodeModel, Port, StepInfo, TreeIr};
+use btc_ir::{
+    push_int, Label, LabelPart, LeafKind, Node, NodeModel, Port, PortValue, StepInfo, TreeIr,
+};
 use btc_pddl::logic::InitFact;
 use names::{is_plain_kwarg, RESERVED};
 pub use names::{push_py_str, py_ident, py_str, Names};
 use std::collections::HashMap;
 use std::fmt::Write;
+use std::sync::Arc;
 
 /// The runtime, as written in the project (linted and unit-tested there).
 pub const RUNTIME: &str = include_str!("../../python/btc_runtime.py");
@@ -94,6 +97,11 @@ struct Emitter<'a> {
     out: String,
     classes: HashMap<&'a str, LeafClass>,
     trees: HashMap<&'a str, usize>,
+    /// Formula and effect ports as Python, by the address of their shared
+    /// value: the steps that repeat a ground action share its guard, which
+    /// is encoded once. (The IR is borrowed for the whole emit, so an
+    /// address names one value.)
+    encoded: std::cell::RefCell<rustc_hash::FxHashMap<usize, Box<str>>>,
 }
 
 pub fn emit(ir: &TreeIr, options: &PyOptions<'_>) -> String {
@@ -107,6 +115,7 @@ pub fn emit(ir: &TreeIr, options: &PyOptions<'_>) -> String {
             .enumerate()
             .map(|(i, t)| (t.id.as_str(), i))
             .collect(),
+        encoded: Default::default(),
     };
     e.header(options);
     e.world();
@@ -279,8 +288,17 @@ impl<'a> Emitter<'a> {
         // module after the shapes, not through a second buffer as large
         // as the plan.
         let mut of_step: Vec<usize> = Vec::with_capacity(self.ir.steps.len());
+        // Steps that repeat a ground action share its logic (the same
+        // values, not equal copies): their shape is found once.
+        let mut by_logic: rustc_hash::FxHashMap<(&str, &[String], [usize; 5]), usize> =
+            Default::default();
         let mut buf = String::new();
         for s in &self.ir.steps {
+            let logic = (s.action.as_str(), s.args.as_slice(), logic_addresses(s));
+            if let Some(&k) = by_logic.get(&logic) {
+                of_step.push(k);
+                continue;
+            }
             buf.clear();
             shape_of(s, &mut buf);
             let k = match index.get(buf.as_str()) {
@@ -291,6 +309,7 @@ impl<'a> Emitter<'a> {
                     shapes.len() - 1
                 }
             };
+            by_logic.insert(logic, k);
             of_step.push(k);
         }
         let o = &mut self.out;
@@ -418,7 +437,9 @@ impl<'a> Emitter<'a> {
                 ..
             } => {
                 let tag = pytrees_code(control.spec());
-                let _ = write!(o, "(\"{tag}\", ");
+                o.push_str("(\"");
+                o.push_str(tag);
+                o.push_str("\", ");
                 push_opt_name(o, name);
                 o.push_str(", ");
                 for v in control.params() {
@@ -458,14 +479,18 @@ impl<'a> Emitter<'a> {
                 id, name, ports, ..
             } => {
                 let class = self.classes.get(id.as_str()).map_or(0, |c| c.index);
-                let _ = write!(o, "(\"L\", {class}, ");
+                o.push_str("(\"L\", ");
+                push_int(o, class);
+                o.push_str(", ");
                 push_opt_name(o, name);
                 o.push_str(", ");
-                ports_tuple(ports, o);
+                self.ports_tuple(ports, o);
                 o.push(')');
             }
             Node::Step { step, child } => {
-                let _ = write!(o, "(\"S\", {step}, ");
+                o.push_str("(\"S\", ");
+                push_int(o, *step);
+                o.push_str(", ");
                 self.node(child, o, indent);
                 o.push(')');
             }
@@ -475,15 +500,17 @@ impl<'a> Emitter<'a> {
                     let positional = params.len() == ports.len()
                         && params.iter().zip(ports).all(|(p, q)| *p == q.name);
                     if positional {
-                        let _ = write!(o, "(\"C\", {t}, (");
+                        o.push_str("(\"C\", ");
+                        push_int(o, t);
+                        o.push_str(", (");
                         for p in ports {
-                            encode::port_value(&p.value, o);
+                            self.port_value(&p.value, o);
                             o.push_str(", ");
                         }
                         o.push_str("))");
                     } else {
                         let _ = write!(o, "(\"K\", {t}, ");
-                        ports_tuple(ports, o);
+                        self.ports_tuple(ports, o);
                         o.push(')');
                     }
                 }
@@ -492,6 +519,36 @@ impl<'a> Emitter<'a> {
                 }
             },
         }
+    }
+
+    /// `(("port", value), ...)`
+    fn ports_tuple(&self, ports: &[Port], o: &mut String) {
+        o.push('(');
+        for p in ports {
+            o.push('(');
+            push_py_str(o, &p.name);
+            o.push_str(", ");
+            self.port_value(&p.value, o);
+            o.push_str("), ");
+        }
+        o.push(')');
+    }
+
+    /// A port's value as Python; a shared formula or effect is encoded
+    /// once.
+    fn port_value(&self, v: &PortValue, o: &mut String) {
+        let key = match v {
+            PortValue::Formula(f) => Arc::as_ptr(f) as usize,
+            PortValue::Effect(e) => Arc::as_ptr(e) as usize,
+            _ => return encode::port_value(v, o),
+        };
+        let mut memo = self.encoded.borrow_mut();
+        let text = memo.entry(key).or_insert_with(|| {
+            let mut s = String::new();
+            encode::port_value(v, &mut s);
+            s.into()
+        });
+        o.push_str(text);
     }
 
     fn footer(&mut self) {
@@ -569,17 +626,19 @@ fn push_opt_name(o: &mut String, name: &Option<Label>) {
     }
 }
 
-/// `(("port", value), ...)`
-fn ports_tuple(ports: &[Port], o: &mut String) {
-    o.push('(');
-    for p in ports {
-        o.push('(');
-        push_py_str(o, &p.name);
-        o.push_str(", ");
-        encode::port_value(&p.value, o);
-        o.push_str("), ");
+/// Where a step's conditions and effects are (0 for none): two steps with
+/// the same addresses, action and arguments have the same shape.
+fn logic_addresses(s: &StepInfo) -> [usize; 5] {
+    fn at<T>(v: &Option<Arc<T>>) -> usize {
+        v.as_ref().map_or(0, |a| Arc::as_ptr(a) as usize)
     }
-    o.push(')');
+    [
+        at(&s.pre_start),
+        at(&s.pre_over_all),
+        at(&s.pre_end),
+        at(&s.eff_start),
+        at(&s.eff_end),
+    ]
 }
 
 /// `(action, pre_start, pre_over_all, pre_end, eff_start, eff_end)`, lifted.
@@ -589,17 +648,19 @@ fn shape_of(s: &StepInfo, out: &mut String) {
     let mut e = encode::Encoder { out, args: &s.args };
     for f in [&s.pre_start, &s.pre_over_all, &s.pre_end] {
         e.out.push_str(", ");
-        e.opt_formula(f.as_ref());
+        e.opt_formula(f.as_deref());
     }
     for x in [&s.eff_start, &s.eff_end] {
         e.out.push_str(", ");
-        e.opt_effect(x.as_ref());
+        e.opt_effect(x.as_deref());
     }
     out.push(')');
 }
 
 fn row_of(s: &StepInfo, shape: usize, out: &mut String) {
-    let _ = write!(out, "    ({shape}, (");
+    out.push_str("    (");
+    push_int(out, shape);
+    out.push_str(", (");
     for a in &s.args {
         push_py_str(out, a);
         out.push_str(", ");
@@ -609,14 +670,15 @@ fn row_of(s: &StepInfo, shape: usize, out: &mut String) {
     if s.duration.is_some() || extra {
         out.push_str(", ");
         match s.duration {
-            Some(d) => out.push_str(&encode::py_float(d)),
+            Some(d) => encode::push_py_float(out, d),
             None => out.push_str("None"),
         }
     }
     if extra {
         out.push_str(if s.skipped { ", True, (" } else { ", False, (" });
         for a in &s.after {
-            let _ = write!(out, "{a}, ");
+            push_int(out, *a);
+            out.push_str(", ");
         }
         out.push(')');
     }

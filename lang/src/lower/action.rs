@@ -1,8 +1,10 @@
 //! A PDDL action's conditions and effects, converted to logic once per
 //! action and grounded per step by the fold.
 
-use btc_pddl::ast::Action;
+use btc_pddl::ast::{Action, Domain};
 use btc_pddl::logic::{ActionSchema, Binding, Effect, Formula, Name, Terms};
+use rustc_hash::FxHashMap;
+use std::sync::Arc;
 
 /// An action's conditions and effects by when they apply, over its
 /// parameters.
@@ -15,13 +17,52 @@ pub(super) struct ActionLogic {
     eff_end: Option<Effect>,
 }
 
-/// A step's ground conditions and effects.
+/// A step's ground conditions and effects, shared by the steps that
+/// repeat the same ground action.
+#[derive(Clone)]
 pub(super) struct Ground {
-    pub pre_start: Option<Formula>,
-    pub pre_over_all: Option<Formula>,
-    pub pre_end: Option<Formula>,
-    pub eff_start: Option<Effect>,
-    pub eff_end: Option<Effect>,
+    pub pre_start: Option<Arc<Formula>>,
+    pub pre_over_all: Option<Arc<Formula>>,
+    pub pre_end: Option<Arc<Formula>>,
+    pub eff_start: Option<Arc<Effect>>,
+    pub eff_end: Option<Arc<Effect>>,
+}
+
+/// Each action's logic, converted when a step first uses it, and each
+/// ground action grounded once: a long plan repeats few ground actions
+/// (the same moves between the same places), and its steps share them.
+#[derive(Default)]
+pub(super) struct Grounder {
+    actions: FxHashMap<usize, (ActionLogic, ByObjects)>,
+}
+
+/// An action's ground forms, by the ids of their objects.
+type ByObjects = FxHashMap<Box<[u32]>, Ground>;
+
+impl Grounder {
+    /// Action `action` of `domain` with the objects `args` (ids) whose
+    /// names are `names`.
+    pub fn ground(
+        &mut self,
+        domain: &Domain,
+        action: usize,
+        args: &[u32],
+        names: &[Name],
+    ) -> Ground {
+        let (logic, grounded) = self.actions.entry(action).or_insert_with(|| {
+            (
+                ActionLogic::new(&domain.actions[action]),
+                FxHashMap::default(),
+            )
+        });
+        if let Some(g) = grounded.get(args) {
+            return g.clone();
+        }
+        let objects: Vec<Name> = args.iter().map(|&o| names[o as usize].clone()).collect();
+        let g = logic.ground(&objects);
+        grounded.insert(Box::from(args), g.clone());
+        g
+    }
 }
 
 impl ActionLogic {
@@ -45,11 +86,11 @@ impl ActionLogic {
             objects,
         };
         Ground {
-            pre_start: self.pre_start.as_ref().map(|f| f.ground(&b)),
-            pre_over_all: self.pre_over_all.as_ref().map(|f| f.ground(&b)),
-            pre_end: self.pre_end.as_ref().map(|f| f.ground(&b)),
-            eff_start: self.eff_start.as_ref().map(|e| e.ground(&b)),
-            eff_end: self.eff_end.as_ref().map(|e| e.ground(&b)),
+            pre_start: self.pre_start.as_ref().map(|f| Arc::new(f.ground(&b))),
+            pre_over_all: self.pre_over_all.as_ref().map(|f| Arc::new(f.ground(&b))),
+            pre_end: self.pre_end.as_ref().map(|f| Arc::new(f.ground(&b))),
+            eff_start: self.eff_start.as_ref().map(|e| Arc::new(e.ground(&b))),
+            eff_end: self.eff_end.as_ref().map(|e| Arc::new(e.ground(&b))),
         }
     }
 }

@@ -7,9 +7,10 @@
 use btc_ir::*;
 use btc_pddl::logic::{Formula, Literal};
 use std::collections::BTreeSet;
+use std::sync::Arc;
 
 /// A KB leaf: `KbHolds(formula)` or `KbApply(effect)`.
-pub(super) fn kb_holds(f: Formula, name: Option<String>) -> Node {
+pub(super) fn kb_holds(f: Arc<Formula>, name: Option<String>) -> Node {
     Node::Leaf {
         scripts: Default::default(),
         leaf: LeafKind::Condition,
@@ -17,7 +18,7 @@ pub(super) fn kb_holds(f: Formula, name: Option<String>) -> Node {
         name: name.map(Label::text),
         ports: vec![Port {
             name: "formula".into(),
-            value: PortValue::Formula(Box::new(f)),
+            value: PortValue::Formula(f),
         }],
     }
 }

@@ -15,6 +15,7 @@ use super::arrange::kb_holds;
 use btc_ir::*;
 use btc_pddl::logic::{Effect, Formula, Literal, Name};
 use std::collections::BTreeSet;
+use std::sync::Arc;
 
 /// Why `steps backchained` cannot regress the goal through the plan: step
 /// `step` makes false a literal (`what`) that the goal or a later step
@@ -214,14 +215,14 @@ struct PlainStep {
 }
 
 fn plain_step(info: &StepInfo, derived: &BTreeSet<Name>, opaque: &mut Opaque) -> PlainStep {
-    let mut cond = |f: &Option<Formula>| match f {
+    let mut cond = |f: &Option<Arc<Formula>>| match f {
         None => Vec::new(),
         Some(f) => condition(f, derived, opaque),
     };
     let mut pre_later = cond(&info.pre_over_all);
     pre_later.extend(cond(&info.pre_end));
     let pre_start = cond(&info.pre_start);
-    let eff = |e: &Option<Effect>| e.as_ref().map(StepEffect::of).unwrap_or_default();
+    let eff = |e: &Option<Arc<Effect>>| e.as_deref().map(StepEffect::of).unwrap_or_default();
     PlainStep {
         pre_start,
         pre_later,
@@ -347,7 +348,7 @@ pub(super) fn stages(
         if i == 0 {
             let all: Vec<&Condition> = conds.iter().collect();
             first.push(kb_holds(
-                any_of(&all, &opaque),
+                Arc::new(any_of(&all, &opaque)),
                 Some("plan can resume?".into()),
             ));
         }
@@ -356,7 +357,7 @@ pub(super) fn stages(
             control: ControlKind::Fallback,
             name: Some(format!("step {label} {}", info.display()).into()),
             children: not_needed
-                .map(|f| kb_holds(f, Some(format!("step {label} not needed?"))))
+                .map(|f| kb_holds(Arc::new(f), Some(format!("step {label} not needed?"))))
                 .into_iter()
                 .chain([Node::Control {
                     scripts: Default::default(),
@@ -364,7 +365,10 @@ pub(super) fn stages(
                     name: None,
                     children: first
                         .into_iter()
-                        .chain([kb_holds(ready, Some(format!("step {label} ready?"))), node])
+                        .chain([
+                            kb_holds(Arc::new(ready), Some(format!("step {label} ready?"))),
+                            node,
+                        ])
                         .collect(),
                 }])
                 .collect(),
