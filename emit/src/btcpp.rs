@@ -8,6 +8,7 @@
 
 use btc_ir::*;
 use std::fmt::Write as _;
+use std::sync::Arc;
 
 /// Whether a character must be escaped (or replaced) in an attribute value.
 fn needs_escape(c: char) -> bool {
@@ -57,7 +58,11 @@ pub fn escape_attr(s: &str) -> std::borrow::Cow<'_, str> {
 
 /// An XML element name from an id: ids are BT.CPP node names, which user
 /// rules spell freely; anything not allowed in a name becomes `_`.
-pub fn element_name(id: &str) -> String {
+pub fn element_name(id: &str) -> std::borrow::Cow<'_, str> {
+    let valid = |c: char| c.is_ascii_alphanumeric() || c == '_' || c == '-' || c == '.';
+    if id.starts_with(|c: char| c.is_ascii_alphabetic() || c == '_') && id.chars().all(valid) {
+        return std::borrow::Cow::Borrowed(id);
+    }
     let mut out: String = id
         .chars()
         .map(|c| {
@@ -71,7 +76,7 @@ pub fn element_name(id: &str) -> String {
     if !out.starts_with(|c: char| c.is_ascii_alphabetic() || c == '_') {
         out.insert(0, '_');
     }
-    out
+    std::borrow::Cow::Owned(out)
 }
 
 /// An indenting XML writer straight into a `String`: elements are opened,
@@ -82,6 +87,14 @@ struct Xml {
     depth: usize,
     /// Where values are printed before they are escaped.
     scratch: String,
+    /// Shared conditions and effects as escaped text, by the address of
+    /// their value: the steps that repeat a ground action share them, and
+    /// each is printed once. (The IR is borrowed for the whole emit, so an
+    /// address names one value.)
+    shared: rustc_hash::FxHashMap<usize, Box<str>>,
+    /// Steps' nodes as XML, by the address of the shared node and the
+    /// depth they were written at.
+    step_nodes: rustc_hash::FxHashMap<(usize, usize), Box<str>>,
 }
 
 impl Xml {
@@ -92,6 +105,8 @@ impl Xml {
             out,
             depth: 0,
             scratch: String::new(),
+            shared: Default::default(),
+            step_nodes: Default::default(),
         }
     }
 
@@ -130,6 +145,27 @@ impl Xml {
         self.out.push_str(key);
         self.out.push_str("=\"");
         escape_attr_into(&mut self.out, &self.scratch);
+        self.out.push('"');
+        self
+    }
+
+    /// [`Xml::attr_display`] of a shared value, printed once per value.
+    fn attr_shared<T: std::fmt::Display>(&mut self, key: &str, value: Option<&Arc<T>>) -> &mut Xml {
+        let Some(v) = value else {
+            return self.attr(key, "");
+        };
+        let text = self
+            .shared
+            .entry(Arc::as_ptr(v) as *const u8 as usize)
+            .or_insert_with(|| {
+                let mut s = String::new();
+                escape_attr_into(&mut s, &v.to_string());
+                s.into()
+            });
+        self.out.push(' ');
+        self.out.push_str(key);
+        self.out.push_str("=\"");
+        self.out.push_str(text);
         self.out.push('"');
         self
     }
@@ -174,6 +210,8 @@ impl Xml {
                 self.out.push_str("}\"");
                 self
             }
+            PortValue::Formula(f) => self.attr_shared(&p.name, Some(f)),
+            PortValue::Effect(e) => self.attr_shared(&p.name, Some(e)),
             other => self.attr(&p.name, &other.to_text()),
         }
     }
@@ -201,6 +239,12 @@ fn number(x: &mut Xml, key: &str, n: impl std::fmt::Display) {
     x.attr_with(key, |out| {
         let _ = write!(out, "{n}");
     });
+}
+
+/// [`number`] for an integer, without the formatting machinery (one per
+/// step of a long plan).
+fn integer(x: &mut Xml, key: &str, n: impl itoa::Integer) {
+    x.attr_with(key, |out| push_int(out, n));
 }
 
 fn node(x: &mut Xml, n: &Node, ir: &TreeIr) {
@@ -265,7 +309,8 @@ fn node(x: &mut Xml, n: &Node, ir: &TreeIr) {
         Node::Step { step, child } => {
             let info = ir.steps.get(*step);
             x.open("KbStep").attr_with("name", |out| {
-                let _ = write!(out, "step {}", step + 1);
+                out.push_str("step ");
+                push_int(out, step + 1);
                 if let Some(s) = info {
                     out.push_str(": (");
                     escape_attr_into(out, &s.action);
@@ -276,9 +321,9 @@ fn node(x: &mut Xml, n: &Node, ir: &TreeIr) {
                     out.push(')');
                 }
             });
-            number(x, "step", step + 1);
-            x.attr_display("start_effect", info.and_then(|s| s.eff_start.as_ref()))
-                .attr_display("end_effect", info.and_then(|s| s.eff_end.as_ref()));
+            integer(x, "step", step + 1);
+            x.attr_shared("start_effect", info.and_then(|s| s.eff_start.as_ref()))
+                .attr_shared("end_effect", info.and_then(|s| s.eff_end.as_ref()));
             // The step's conditions, so an executor that does not read the
             // domain checks what `btc run` checks (written only when there
             // are some: most steps have just a precondition).
@@ -289,15 +334,29 @@ fn node(x: &mut Xml, n: &Node, ir: &TreeIr) {
                     ("end_condition", &s.pre_end),
                 ] {
                     if cond.is_some() {
-                        x.attr_display(key, cond.as_ref());
+                        x.attr_shared(key, cond.as_ref());
                     }
                 }
             }
             x.close(false);
-            node(x, child, ir);
+            shared_node(x, child, ir);
             x.end("KbStep");
         }
     }
+}
+
+/// [`node`] of a node that steps share: written once per depth, then
+/// copied.
+fn shared_node(x: &mut Xml, n: &Arc<Node>, ir: &TreeIr) {
+    let key = (Arc::as_ptr(n) as usize, x.depth);
+    if let Some(text) = x.step_nodes.get(&key) {
+        x.out.push_str(text);
+        return;
+    }
+    let start = x.out.len();
+    node(x, n, ir);
+    let text = x.out[start..].into();
+    x.step_nodes.insert(key, text);
 }
 
 /// The XML document for a compiled plan.

@@ -101,7 +101,8 @@ fn flatten(root: &Node, ir: &TreeIr) -> Flat {
         nodes.push((label, shape));
         let children: Vec<&Node> = match n {
             Node::Control { children, .. } => children.iter().collect(),
-            Node::Decorator { child, .. } | Node::Step { child, .. } => vec![child],
+            Node::Decorator { child, .. } => vec![child],
+            Node::Step { child, .. } => vec![child],
             _ => Vec::new(),
         };
         // Reversed so the stack pops them left to right.

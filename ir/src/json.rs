@@ -168,7 +168,7 @@ fn upgrade_node(n: Node) -> Result<Node, String> {
         },
         Node::Step { step, child } => Node::Step {
             step,
-            child: Box::new(upgrade_node(*child)?),
+            child: Arc::new(upgrade_node(Arc::unwrap_or_clone(child))?),
         },
         other @ Node::SubTree { .. } => other,
     })

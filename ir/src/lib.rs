@@ -11,6 +11,7 @@
 
 use btc_pddl::logic::{Effect, Formula};
 use btc_pddl::world::WorldModel;
+use rustc_hash::FxHashSet;
 use serde::{Deserialize, Serialize};
 use std::collections::HashSet;
 use std::sync::Arc;
@@ -143,8 +144,10 @@ pub enum Node {
         scripts: NodeScripts,
     },
     /// The boundary of plan step `step` (0-based): its at-start effects apply
-    /// when it starts, its at-end effects when `child` succeeds.
-    Step { step: usize, child: Box<Node> },
+    /// when it starts, its at-end effects when `child` succeeds. The steps
+    /// that repeat a ground action share their `child` (a long plan
+    /// repeats few), and emitters write a shared child once.
+    Step { step: usize, child: Arc<Node> },
 }
 
 impl Node {
@@ -157,12 +160,33 @@ impl Node {
         }
     }
 
+    /// [`Node::walk`] that goes into a child that steps share once, for
+    /// passes that collect what a tree uses: a long plan's steps share few
+    /// children.
+    pub fn walk_distinct<'a>(&'a self, f: &mut impl FnMut(&'a Node)) {
+        fn go<'a>(n: &'a Node, f: &mut impl FnMut(&'a Node), seen: &mut FxHashSet<*const Node>) {
+            f(n);
+            match n {
+                Node::Control { children, .. } => children.iter().for_each(|c| go(c, f, seen)),
+                Node::Decorator { child, .. } => go(child, f, seen),
+                Node::Step { child, .. } => {
+                    if seen.insert(Arc::as_ptr(child)) {
+                        go(child, f, seen)
+                    }
+                }
+                Node::Leaf { .. } | Node::SubTree { .. } => {}
+            }
+        }
+        go(self, f, &mut FxHashSet::default())
+    }
+
     /// Calls `f` on this node and every node below it (not into subtrees).
     pub fn walk<'a>(&'a self, f: &mut impl FnMut(&'a Node)) {
         f(self);
         match self {
             Node::Control { children, .. } => children.iter().for_each(|c| c.walk(f)),
-            Node::Decorator { child, .. } | Node::Step { child, .. } => child.walk(f),
+            Node::Decorator { child, .. } => child.walk(f),
+            Node::Step { child, .. } => child.walk(f),
             Node::Leaf { .. } | Node::SubTree { .. } => {}
         }
     }
@@ -426,7 +450,7 @@ impl TreeIr {
             },
             Node::Step { step, child } => Node::Step {
                 step: *step,
-                child: Box::new(self.inline_node(child, args, depth, only)),
+                child: Arc::new(self.inline_node(child, args, depth, only)),
             },
             Node::SubTree { id, ports, scripts } => match self.tree(id) {
                 Some(def) if depth < MAX_CALL_DEPTH && only.is_none_or(|ids| ids.contains(id)) => {

@@ -593,6 +593,16 @@ fn rule_id(r: &Rule, taken: &BTreeSet<String>) -> String {
 }
 
 /// Lowers a plan; every problem is reported at the plan line of its step.
+/// How a ground action lowers: the rule tree it calls (`None`: skipped),
+/// its effects (a rule's `effect` replaces the action's) and the step's
+/// node below its `Step` boundary.
+struct Lowered {
+    rule: Option<String>,
+    eff_start: Option<Arc<logic::Effect>>,
+    eff_end: Option<Arc<logic::Effect>>,
+    child: Option<Arc<Node>>,
+}
+
 pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
     let mut diags = Vec::new();
     let types = Types {
@@ -602,6 +612,10 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
     let tables = |name: &str| input.decls.tables.get(name).cloned();
     let mut grounder = Grounder::default();
     let mut guard_names: rustc_hash::FxHashMap<usize, Label> = Default::default();
+    // Each ground action's lowering, for the steps that repeat it: which
+    // rule, which tree call and guard, which effects depend on the action
+    // and its objects only, never on the step's place in the plan.
+    let mut lowered: rustc_hash::FxHashMap<(usize, &[u32]), Lowered> = Default::default();
     let mut rule_effects: BTreeMap<usize, RuleEffect> = BTreeMap::new();
     let mut rule_trees: Vec<(usize, RuleTree)> = Vec::new(); // by rule index
     let mut taken = BTreeSet::new();
@@ -623,6 +637,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
         let step = &input.plan.steps[g.step];
         let action = &input.domain.actions[g.action];
         let ground = grounder.ground(input.domain, g.action, &g.args, &object_names);
+        let repeated = lowered.get(&(g.action, g.args.as_slice()));
         let mut info = StepInfo {
             index: k,
             line: step.line,
@@ -643,6 +658,19 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
             eff_end: ground.eff_end,
             after: Vec::new(),
         };
+        if let Some(r) = repeated {
+            info.rule = r.rule.clone();
+            info.skipped = r.rule.is_none();
+            info.eff_start = r.eff_start.clone();
+            info.eff_end = r.eff_end.clone();
+            step_nodes.push(r.child.as_ref().map(|c| Node::Step {
+                step: k,
+                child: c.clone(),
+            }));
+            infos.push(info);
+            continue;
+        }
+        let diags_before = diags.len();
         let args = &info.args;
         // Names match once per (rule, action); steps repeat actions a lot.
         let found = input.rules.iter().enumerate().find_map(|(ri, r)| {
@@ -689,6 +717,15 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
         };
         let RuleBody::Template { body, effect } = &rule.body else {
             info.skipped = true;
+            lowered.insert(
+                (g.action, g.args.as_slice()),
+                Lowered {
+                    rule: None,
+                    eff_start: info.eff_start.clone(),
+                    eff_end: info.eff_end.clone(),
+                    child: None,
+                },
+            );
             infos.push(info);
             step_nodes.push(None);
             continue;
@@ -845,10 +882,20 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
                 children: vec![kb_holds(over.clone(), None), child],
             };
         }
-        step_nodes.push(Some(Node::Step {
-            step: k,
-            child: Box::new(child),
-        }));
+        let child = Arc::new(child);
+        // A step with a diagnostic is not reused: each step reports its own.
+        if diags.len() == diags_before {
+            lowered.insert(
+                (g.action, g.args.as_slice()),
+                Lowered {
+                    rule: info.rule.clone(),
+                    eff_start: info.eff_start.clone(),
+                    eff_end: info.eff_end.clone(),
+                    child: Some(Arc::clone(&child)),
+                },
+            );
+        }
+        step_nodes.push(Some(Node::Step { step: k, child }));
         infos.push(info);
     }
     if !diags.is_empty() {
@@ -921,7 +968,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
     if !arrange_diags.is_empty() {
         return Err(arrange_diags);
     }
-    root.walk(&mut |n| {
+    root.walk_distinct(&mut |n| {
         if let Node::Leaf { id, .. } = n {
             used_kb.insert(id.clone());
         }

@@ -136,7 +136,7 @@ fn uses_scripts(ir: &TreeIr) -> bool {
             Node::Step { .. } => false,
         };
     };
-    ir.root.walk(&mut look);
+    ir.root.walk_distinct(&mut look);
     for t in &ir.trees {
         t.root.walk(&mut look);
     }
@@ -157,7 +157,7 @@ fn nodes_not_in_pytrees(ir: &TreeIr) -> Vec<DecoratorName> {
             }
         }
     };
-    ir.root.walk(&mut look);
+    ir.root.walk_distinct(&mut look);
     for t in &ir.trees {
         t.root.walk(&mut look);
     }
@@ -201,7 +201,7 @@ fn uses_leaf(ir: &TreeIr, id: &str) -> bool {
             found |= leaf == id;
         }
     };
-    ir.root.walk(&mut look);
+    ir.root.walk_distinct(&mut look);
     for t in &ir.trees {
         t.root.walk(&mut look);
     }

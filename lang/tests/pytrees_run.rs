@@ -457,7 +457,7 @@ fn hostile_ir() -> TreeIr {
     };
     let mut children = vec![Node::Step {
         step: 0,
-        child: Box::new(Node::SubTree {
+        child: std::sync::Arc::new(Node::SubTree {
             scripts: Default::default(),
             id: tree.id.clone(),
             ports: vec![port("x", text(OBJ_C))],
@@ -485,7 +485,7 @@ fn hostile_ir() -> TreeIr {
     ));
     children.push(Node::Step {
         step: 1,
-        child: Box::new(Node::Decorator {
+        child: std::sync::Arc::new(Node::Decorator {
             scripts: Default::default(),
             decorator: DecoratorKind::Retry {
                 times: btc_ir::Count::Fixed(2),

@@ -102,6 +102,9 @@ struct Emitter<'a> {
     /// is encoded once. (The IR is borrowed for the whole emit, so an
     /// address names one value.)
     encoded: std::cell::RefCell<rustc_hash::FxHashMap<usize, Box<str>>>,
+    /// Steps' nodes as Python, by the address of the shared node and the
+    /// indent they were written at.
+    step_nodes: std::cell::RefCell<rustc_hash::FxHashMap<(usize, usize), Box<str>>>,
 }
 
 pub fn emit(ir: &TreeIr, options: &PyOptions<'_>) -> String {
@@ -116,6 +119,7 @@ pub fn emit(ir: &TreeIr, options: &PyOptions<'_>) -> String {
             .map(|(i, t)| (t.id.as_str(), i))
             .collect(),
         encoded: Default::default(),
+        step_nodes: Default::default(),
     };
     e.header(options);
     e.world();
@@ -352,7 +356,7 @@ impl<'a> Emitter<'a> {
         }
         // The main tree has one node per step at least: walk it only for
         // leaves outside the rules' trees.
-        self.ir.root.walk(&mut add);
+        self.ir.root.walk_distinct(&mut add);
         models
     }
 
@@ -491,7 +495,7 @@ impl<'a> Emitter<'a> {
                 o.push_str("(\"S\", ");
                 push_int(o, *step);
                 o.push_str(", ");
-                self.node(child, o, indent);
+                self.shared_node(child, o, indent);
                 o.push(')');
             }
             Node::SubTree { id, ports, .. } => match self.trees.get(id.as_str()) {
@@ -519,6 +523,18 @@ impl<'a> Emitter<'a> {
                 }
             },
         }
+    }
+
+    /// [`Emitter::node`] of a node that steps share: written once per
+    /// indent, then copied.
+    fn shared_node(&self, n: &Arc<Node>, o: &mut String, indent: usize) {
+        let key = (Arc::as_ptr(n) as usize, indent);
+        if let Some(text) = self.step_nodes.borrow().get(&key) {
+            return o.push_str(text);
+        }
+        let start = o.len();
+        self.node(n, o, indent);
+        self.step_nodes.borrow_mut().insert(key, o[start..].into());
     }
 
     /// `(("port", value), ...)`
@@ -585,9 +601,8 @@ impl<'a> Emitter<'a> {
                 Node::Control { children, .. } => {
                     children.iter().map(|c| count(ir, c, memo, depth)).sum()
                 }
-                Node::Decorator { child, .. } | Node::Step { child, .. } => {
-                    count(ir, child, memo, depth)
-                }
+                Node::Decorator { child, .. } => count(ir, child, memo, depth),
+                Node::Step { child, .. } => count(ir, child, memo, depth),
                 Node::SubTree { id, .. } => {
                     if let Some(&k) = memo.get(id.as_str()) {
                         return k;
