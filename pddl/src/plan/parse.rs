@@ -63,17 +63,17 @@ pub fn parse_plan(text: &str, file: FileId) -> (Plan, Vec<Diagnostic>) {
 /// [`parse_plan`], with the fast path for common step lines or without it
 /// (to test that the two agree).
 fn read_plan(text: &str, file: FileId, quick: bool) -> (Plan, Vec<Diagnostic>) {
+    // At most a step a line: counting them is cheaper than growing a long
+    // plan's steps a dozen times.
+    let lines = memchr::memchr_iter(b'\n', text.as_bytes()).count() + 1;
     let mut plan = Plan {
         format: PlanFormat::Empty,
-        steps: Vec::new(),
+        steps: Vec::with_capacity(lines),
         stated_cost: None,
     };
     let mut diags = Vec::new();
-    let mut offset = 0usize;
     let mut in_ff = false;
-    for (i, raw) in text.split('\n').enumerate() {
-        let line_start = offset;
-        offset += raw.len() + 1;
+    for (i, (line_start, raw)) in lines_of(text).enumerate() {
         let line = raw.strip_suffix('\r').unwrap_or(raw);
         let place = quick::Place {
             base: line_start,
@@ -118,6 +118,18 @@ fn read_plan(text: &str, file: FileId, quick: bool) -> (Plan, Vec<Diagnostic>) {
         });
     }
     (plan, diags)
+}
+
+/// Each line's start and text without its `\n`, as `split('\n')` cuts
+/// them (an empty last line after a final `\n`), found with SIMD.
+fn lines_of(text: &str) -> impl Iterator<Item = (usize, &str)> {
+    let ends = memchr::memchr_iter(b'\n', text.as_bytes()).chain([text.len()]);
+    let mut start = 0;
+    ends.map(move |end| {
+        let line = (start, &text[start..end]);
+        start = end + 1;
+        line
+    })
 }
 
 enum Line {
@@ -679,6 +691,22 @@ mod tests {
                 want.to_bits(),
                 "{s}"
             );
+        }
+    }
+
+    #[test]
+    fn lines_are_cut_as_split_cuts_them() {
+        for text in ["", "\n", "a", "a\n", "a\nb", "\n\na\r\n\nb\n", "é\nü"] {
+            let mut offset = 0;
+            let want: Vec<(usize, &str)> = text
+                .split('\n')
+                .map(|l| {
+                    let start = offset;
+                    offset += l.len() + 1;
+                    (start, l)
+                })
+                .collect();
+            assert_eq!(lines_of(text).collect::<Vec<_>>(), want, "{text:?}");
         }
     }
 }

@@ -41,13 +41,13 @@ pub(super) fn step(text: &str, at: Place) -> Option<Line> {
         return None;
     }
     let open = pos;
-    let (mut words, close) = names(text, open + 1, at)?;
+    let (action, after) = name(text, open + 1, at)?;
+    let (args, close) = args(text, after, at)?;
     let (duration, end) = duration(b, skip_ws(b, close + 1))?;
     // Only a comment may follow.
     if end < b.len() && b[end] != b';' {
         return None;
     }
-    let action = words.remove(0);
     let format = match time {
         Some(_) => PlanFormat::Timed,
         None => PlanFormat::SasPlan,
@@ -56,7 +56,7 @@ pub(super) fn step(text: &str, at: Place) -> Option<Line> {
         format,
         PlanStep {
             action,
-            args: words,
+            args,
             time,
             duration,
             line: at.line,
@@ -65,45 +65,71 @@ pub(super) fn step(text: &str, at: Place) -> Option<Line> {
     ))
 }
 
+/// What the fast path tells apart in a byte.
+const OTHER: u8 = 0;
+const NAME: u8 = 1;
+const SPACE: u8 = 2;
+
+/// Each byte's class, looked up once per byte. Names are the ASCII bytes
+/// of PDDL names; the careful reader also takes other alphanumeric
+/// characters, and lower-cases them its own way.
+static CLASS: [u8; 256] = {
+    let mut t = [OTHER; 256];
+    let mut i = 0;
+    while i < 256 {
+        let c = i as u8;
+        if c.is_ascii_alphanumeric() || matches!(c, b'-' | b'_' | b'.' | b'@') {
+            t[i] = NAME;
+        } else if c.is_ascii_whitespace() {
+            t[i] = SPACE;
+        }
+        i += 1;
+    }
+    t
+};
+
 fn skip_ws(b: &[u8], mut pos: usize) -> usize {
-    while pos < b.len() && b[pos].is_ascii_whitespace() {
+    while pos < b.len() && CLASS[b[pos] as usize] == SPACE {
         pos += 1;
     }
     pos
 }
 
-/// The ASCII bytes of PDDL names; the careful reader also takes other
-/// alphanumeric characters, and lower-cases them its own way.
-fn is_name_byte(c: u8) -> bool {
-    c.is_ascii_alphanumeric() || matches!(c, b'-' | b'_' | b'.' | b'@')
+/// The name after the spaces at `pos`, and where it ends; `None` unless
+/// it ends at a space or a `)` (anything else is not a name the fast path
+/// knows).
+fn name(text: &str, pos: usize, at: Place) -> Option<(Name, usize)> {
+    let b = text.as_bytes();
+    let start = skip_ws(b, pos);
+    let mut end = start;
+    while end < b.len() && CLASS[b[end] as usize] == NAME {
+        end += 1;
+    }
+    let next = *b.get(end)?;
+    if end == start || !(next == b')' || CLASS[next as usize] == SPACE) {
+        return None;
+    }
+    let name = Name {
+        name: text[start..end].to_ascii_lowercase(),
+        span: at.span(start, end),
+    };
+    Some((name, end))
 }
 
 /// The names from `pos` to the `)`, which must be on the line, and the
-/// `)`'s position; at least one name.
-fn names(text: &str, mut pos: usize, at: Place) -> Option<(Vec<Name>, usize)> {
+/// `)`'s position.
+fn args(text: &str, mut pos: usize, at: Place) -> Option<(Vec<Name>, usize)> {
     let b = text.as_bytes();
-    let mut words = Vec::with_capacity(4);
+    let mut args = Vec::with_capacity(4);
     loop {
         pos = skip_ws(b, pos);
         if *b.get(pos)? == b')' {
-            break;
+            return Some((args, pos));
         }
-        let start = pos;
-        while pos < b.len() && is_name_byte(b[pos]) {
-            pos += 1;
-        }
-        // A name ends at a space or the `)`; anything else is not a
-        // name the fast path knows.
-        let next = *b.get(pos)?;
-        if pos == start || !(next.is_ascii_whitespace() || next == b')') {
-            return None;
-        }
-        words.push(Name {
-            name: text[start..pos].to_ascii_lowercase(),
-            span: at.span(start, pos),
-        });
+        let (arg, end) = name(text, pos, at)?;
+        args.push(arg);
+        pos = end;
     }
-    (!words.is_empty()).then_some((words, pos))
 }
 
 /// An optional `[DURATION]` at `pos`, and where the line goes on after it.
@@ -120,26 +146,58 @@ fn duration(b: &[u8], pos: usize) -> Option<(Option<f64>, usize)> {
 
 /// `DIGITS` or `DIGITS.DIGITS` at `pos`: its finite value and its end.
 fn number(b: &[u8], pos: usize) -> Option<(f64, usize)> {
-    let int_end = digits_end(b, pos);
-    let mut end = int_end;
-    if b.get(int_end) == Some(&b'.') {
-        end = digits_end(b, int_end + 1);
-        if end == int_end + 1 {
-            return None;
-        }
-    }
+    let mut d = Digits::default();
+    let int_end = d.read(b, pos);
     if int_end == pos {
         return None;
     }
-    let v = decimal(&b[pos..end]);
+    let mut end = int_end;
+    if b.get(int_end) == Some(&b'.') {
+        end = d.read(b, int_end + 1);
+        d.frac = end - (int_end + 1);
+        if d.frac == 0 {
+            return None;
+        }
+    }
+    let v = d.value(&b[pos..end]);
     v.is_finite().then_some((v, end))
 }
 
-fn digits_end(b: &[u8], mut pos: usize) -> usize {
-    while pos < b.len() && b[pos].is_ascii_digit() {
-        pos += 1;
+/// The digits of a number read so far.
+#[derive(Default)]
+struct Digits {
+    mantissa: u64,
+    count: usize,
+    frac: usize,
+}
+
+impl Digits {
+    /// Reads the digits from `pos`; returns where they end.
+    fn read(&mut self, b: &[u8], mut pos: usize) -> usize {
+        while let Some(c) = b.get(pos).filter(|c| c.is_ascii_digit()) {
+            self.mantissa = self
+                .mantissa
+                .wrapping_mul(10)
+                .wrapping_add(u64::from(c - b'0'));
+            self.count += 1;
+            pos += 1;
+        }
+        pos
     }
-    pos
+
+    /// The value of `text`, whose digits these are, as `str::parse::<f64>`
+    /// reads it. With at most 15 digits the digits and the power of ten are
+    /// exact doubles, so one division is correctly rounded (Clinger's fast
+    /// path), as `parse` is; longer numbers go through `parse`.
+    fn value(&self, text: &[u8]) -> f64 {
+        if self.count <= 15 {
+            return self.mantissa as f64 / POW10[self.frac];
+        }
+        std::str::from_utf8(text)
+            .ok()
+            .and_then(|t| t.parse().ok())
+            .unwrap_or(f64::NAN)
+    }
 }
 
 /// Exact powers of ten: every one up to 1e22 is a double.
@@ -148,27 +206,8 @@ const POW10: [f64; 23] = [
     1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
 ];
 
-/// The value of `DIGITS[.DIGITS]`, as `str::parse::<f64>` reads it. With
-/// at most 15 digits the digits and the power of ten are exact doubles, so
-/// one division is correctly rounded (Clinger's fast path), as `parse` is;
-/// longer numbers go through `parse`.
+/// The value of `DIGITS[.DIGITS]` (for tests: what [`number`] reads).
+#[cfg(test)]
 pub(super) fn decimal(s: &[u8]) -> f64 {
-    let mut mantissa: u64 = 0;
-    let (mut count, mut frac, mut after_dot) = (0usize, 0usize, false);
-    for &c in s {
-        if c == b'.' {
-            after_dot = true;
-            continue;
-        }
-        mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(c - b'0'));
-        count += 1;
-        frac += usize::from(after_dot);
-    }
-    if count <= 15 {
-        return mantissa as f64 / POW10[frac];
-    }
-    std::str::from_utf8(s)
-        .ok()
-        .and_then(|t| t.parse().ok())
-        .unwrap_or(f64::NAN)
+    number(s, 0).map_or(f64::NAN, |(v, _)| v)
 }
