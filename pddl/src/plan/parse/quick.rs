@@ -65,10 +65,12 @@ pub(super) fn step(text: &str, at: Place) -> Option<Line> {
     ))
 }
 
-/// What the fast path tells apart in a byte.
+/// What the fast path tells apart in a byte (flags: an upper-case letter
+/// is a name byte too).
 const OTHER: u8 = 0;
 const NAME: u8 = 1;
-const SPACE: u8 = 2;
+const UPPER: u8 = 2;
+const SPACE: u8 = 4;
 
 /// Each byte's class, looked up once per byte. Names are the ASCII bytes
 /// of PDDL names; the careful reader also takes other alphanumeric
@@ -78,7 +80,9 @@ static CLASS: [u8; 256] = {
     let mut i = 0;
     while i < 256 {
         let c = i as u8;
-        if c.is_ascii_alphanumeric() || matches!(c, b'-' | b'_' | b'.' | b'@') {
+        if c.is_ascii_uppercase() {
+            t[i] = NAME | UPPER;
+        } else if c.is_ascii_alphanumeric() || matches!(c, b'-' | b'_' | b'.' | b'@') {
             t[i] = NAME;
         } else if c.is_ascii_whitespace() {
             t[i] = SPACE;
@@ -101,16 +105,22 @@ fn skip_ws(b: &[u8], mut pos: usize) -> usize {
 fn name(text: &str, pos: usize, at: Place) -> Option<(Name, usize)> {
     let b = text.as_bytes();
     let start = skip_ws(b, pos);
-    let mut end = start;
-    while end < b.len() && CLASS[b[end] as usize] == NAME {
+    let (mut end, mut seen) = (start, OTHER);
+    while end < b.len() && CLASS[b[end] as usize] & NAME != 0 {
+        seen |= CLASS[b[end] as usize];
         end += 1;
     }
     let next = *b.get(end)?;
     if end == start || !(next == b')' || CLASS[next as usize] == SPACE) {
         return None;
     }
+    let mut name = text[start..end].to_owned();
+    // Most arguments are written in lower case already.
+    if seen & UPPER != 0 {
+        name.make_ascii_lowercase();
+    }
     let name = Name {
-        name: text[start..end].to_ascii_lowercase(),
+        name,
         span: at.span(start, end),
     };
     Some((name, end))
