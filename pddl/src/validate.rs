@@ -31,10 +31,11 @@ pub fn validate(
     let mut state = world.initial_state();
     let mut diags = Vec::new();
     let mut actions = Actions::new(world, domain);
+    let mut scratch = Scratch::default();
     for (n, g) in steps.iter().enumerate() {
         let applied = actions
             .get(g.action)
-            .and_then(|a| apply_step(world, &a, &mut state, plan, g));
+            .and_then(|a| apply_step(world, &a, &mut state, plan, g, &mut scratch));
         if let Err(d) = applied {
             diags.push(d);
             return Validation {
@@ -162,6 +163,14 @@ fn missing_goals(world: &World, state: &State, goal: &Formula, cond: &Cond) -> V
     }
 }
 
+/// What every step needs room for, kept from step to step so that a long
+/// replay does not allocate it again for each.
+#[derive(Default)]
+struct Scratch {
+    binding: Vec<u32>,
+    changes: Changes,
+}
+
 /// Applies one step: durative actions as start conditions, start effects,
 /// over-all and end conditions, end effects.
 fn apply_step(
@@ -170,13 +179,16 @@ fn apply_step(
     state: &mut State,
     plan: &Plan,
     g: &GroundStep,
+    scratch: &mut Scratch,
 ) -> Result<(), Diagnostic> {
     let c = &action.compiled;
     let a = action.ast;
     let step = &plan.steps[g.step];
-    let mut binding = g.args.clone();
+    let Scratch { binding, changes } = scratch;
+    binding.clear();
+    binding.extend_from_slice(&g.args);
     let duration = match &c.duration {
-        Some(d) => world.value(state, d, &binding, None).or(step.duration),
+        Some(d) => world.value(state, d, binding, None).or(step.duration),
         None => step.duration,
     };
     let start_phase = if a.durative {
@@ -191,25 +203,25 @@ fn apply_step(
         action: a,
         duration,
     };
-    ctx.check(state, &c.pre_start, &a.pre_start, &mut binding, start_phase)?;
+    ctx.check(state, &c.pre_start, &a.pre_start, binding, start_phase)?;
     if a.durative {
-        ctx.apply_effects(state, &c.eff_start, &mut binding)?;
+        ctx.apply_effects(state, &c.eff_start, binding, changes)?;
         ctx.check(
             state,
             &c.pre_over_all,
             &a.pre_over_all,
-            &mut binding,
+            binding,
             "its `over all` condition",
         )?;
         ctx.check(
             state,
             &c.pre_end,
             &a.pre_end,
-            &mut binding,
+            binding,
             "its `at end` condition",
         )?;
     }
-    ctx.apply_effects(state, &c.eff_end, &mut binding)
+    ctx.apply_effects(state, &c.eff_end, binding, changes)
 }
 
 struct StepCtx<'w> {
@@ -253,11 +265,11 @@ impl StepCtx<'_> {
         state: &mut State,
         effects: &[Eff],
         binding: &mut Vec<u32>,
+        changes: &mut Changes,
     ) -> Result<(), Diagnostic> {
         let (world, g) = (self.world, self.g);
-        let mut changes = Changes::default();
         for e in effects {
-            world.collect(state, e, binding, self.duration, &mut changes);
+            world.collect(state, e, binding, self.duration, changes);
         }
         if let Some(err) = changes.numeric_errors.first() {
             return Err(Diagnostic::error(
@@ -275,7 +287,7 @@ impl StepCtx<'_> {
                 "give the function a value in the problem's `:init`, e.g. `(= (total-cost) 0)`",
             ));
         }
-        world.apply(state, changes);
+        world.apply_changes(state, changes);
         Ok(())
     }
 }

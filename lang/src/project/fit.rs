@@ -20,7 +20,9 @@ pub fn plan_diagnostics(db: &dyn Db, job: CompileJob) -> Vec<Diagnostic> {
         return tp.diagnostics.clone();
     };
     let cp = checked_problem(db, ProblemOf::new(db, p, d));
-    let fit = NameFit::of(&tp.plan, &cp.index);
+    let Some(fit) = job_name_fit(db, job) else {
+        return tp.diagnostics.clone();
+    };
     if fit.fits() {
         return tp.diagnostics.clone();
     }
@@ -47,6 +49,17 @@ pub fn plan_diagnostics(db: &dyn Db, job: CompileJob) -> Vec<Diagnostic> {
         misfit.hint = misfit.hint.map(|h| format!("{h}: pass `--problem {one}`"));
     }
     fold_unknown_objects(&tp.diagnostics, misfit)
+}
+
+/// The plan's object names weighed against the job's problem (`None`
+/// without a domain and a problem). A query: the plan's report and the
+/// loader's question about neighbours both read it, and it walks every
+/// argument of the plan.
+#[salsa::tracked(returns(ref))]
+fn job_name_fit(db: &dyn Db, job: CompileJob) -> Option<NameFit> {
+    let (d, p) = (job_domain(db, job)?, job_problem(db, job)?);
+    let cp = checked_problem(db, ProblemOf::new(db, p, d));
+    Some(NameFit::of(&typed_plan(db, job).plan, &cp.index))
 }
 
 /// The problems beside the job's plan that the database holds, other than
@@ -158,12 +171,10 @@ fn replay(db: &dyn Db, job: CompileJob, problem: SourceFile) -> Option<Vec<Diagn
 /// Whether looking at the problems beside the plan could say more: the
 /// plan names objects the problem lacks, or does not replay on it.
 pub fn wants_neighbours(db: &dyn Db, job: CompileJob) -> bool {
-    let (Some(d), Some(p)) = (job_domain(db, job), job_problem(db, job)) else {
+    let Some(fit) = job_name_fit(db, job) else {
         return false;
     };
-    let cp = checked_problem(db, ProblemOf::new(db, p, d));
-    !NameFit::of(&typed_plan(db, job).plan, &cp.index).fits()
-        || !plan_validation(db, job).is_empty()
+    !fit.fits() || !plan_validation(db, job).is_empty()
 }
 
 /// The folder a plan's neighbours are in.

@@ -20,7 +20,9 @@ pub struct NameFit {
 
 impl NameFit {
     pub fn of(plan: &Plan, pix: &ProblemIndex) -> NameFit {
-        let mut seen = std::collections::HashSet::new();
+        // Plans are the user's own files, not hostile input: no need for
+        // SipHash's flooding resistance on a name per argument.
+        let mut seen = rustc_hash::FxHashSet::default();
         let mut unknown = Vec::new();
         for arg in plan.steps.iter().flat_map(|s| &s.args) {
             if seen.insert(arg.name.as_str()) && !pix.objects.contains_key(&arg.name) {

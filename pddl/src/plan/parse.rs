@@ -11,6 +11,8 @@ use crate::diagnostic::{codes, Diagnostic};
 use crate::source::{FileId, Span};
 use serde::Serialize;
 
+mod quick;
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum PlanFormat {
@@ -55,26 +57,34 @@ pub struct Plan {
 /// Reads a plan. Lines that cannot be read are reported with their line and
 /// column; the others are still returned.
 pub fn parse_plan(text: &str, file: FileId) -> (Plan, Vec<Diagnostic>) {
+    read_plan(text, file, true)
+}
+
+/// [`parse_plan`], with the fast path for common step lines or without it
+/// (to test that the two agree).
+fn read_plan(text: &str, file: FileId, quick: bool) -> (Plan, Vec<Diagnostic>) {
+    // At most a step a line: counting them is cheaper than growing a long
+    // plan's steps a dozen times.
+    let lines = memchr::memchr_iter(b'\n', text.as_bytes()).count() + 1;
     let mut plan = Plan {
         format: PlanFormat::Empty,
-        steps: Vec::new(),
+        steps: Vec::with_capacity(lines),
         stated_cost: None,
     };
     let mut diags = Vec::new();
-    let mut offset = 0usize;
     let mut in_ff = false;
-    for (i, raw) in text.split('\n').enumerate() {
-        let line_start = offset;
-        offset += raw.len() + 1;
+    for (i, (line_start, raw)) in lines_of(text).enumerate() {
         let line = raw.strip_suffix('\r').unwrap_or(raw);
-        let mut l = LineReader {
-            text: line,
-            pos: 0,
+        let place = quick::Place {
             base: line_start,
             file,
             line: i as u32 + 1,
         };
-        match l.read(&mut in_ff) {
+        let read = match quick.then(|| quick::step(line, place)).flatten() {
+            Some(l) => Ok(l),
+            None => LineReader::new(line, place).read(&mut in_ff),
+        };
+        match read {
             Ok(Line::Blank) => {}
             Ok(Line::Comment) => {
                 if let Some(c) = stated_cost(line, line_start, file) {
@@ -110,6 +120,18 @@ pub fn parse_plan(text: &str, file: FileId) -> (Plan, Vec<Diagnostic>) {
     (plan, diags)
 }
 
+/// Each line's start and text without its `\n`, as `split('\n')` cuts
+/// them (an empty last line after a final `\n`), found with SIMD.
+fn lines_of(text: &str) -> impl Iterator<Item = (usize, &str)> {
+    let ends = memchr::memchr_iter(b'\n', text.as_bytes()).chain([text.len()]);
+    let mut start = 0;
+    ends.map(move |end| {
+        let line = (start, &text[start..end]);
+        start = end + 1;
+        line
+    })
+}
+
 enum Line {
     Blank,
     Comment,
@@ -137,6 +159,16 @@ fn is_word_byte(b: u8) -> bool {
 }
 
 impl<'a> LineReader<'a> {
+    fn new(text: &'a str, at: quick::Place) -> LineReader<'a> {
+        LineReader {
+            text,
+            pos: 0,
+            base: at.base,
+            file: at.file,
+            line: at.line,
+        }
+    }
+
     fn span(&self, start: usize, end: usize) -> Span {
         Span::new(self.file, self.base + start, self.base + end)
     }
@@ -473,5 +505,208 @@ mod tests {
         assert_eq!(plan.steps.len(), 1);
         let at: Vec<_> = diags.iter().map(|d| (d.code, d.span.start)).collect();
         assert_eq!(at, vec![("L001", 0), ("L001", 16), ("L001", 37)]);
+    }
+
+    /// Both readers on `text`, whole and line by line.
+    fn assert_readers_agree(text: &str, what: &str) {
+        assert_eq!(
+            read_plan(text, 3, true),
+            read_plan(text, 3, false),
+            "{what}"
+        );
+        for line in text.lines() {
+            assert_eq!(
+                read_plan(line, 3, true),
+                read_plan(line, 3, false),
+                "{what}: {line:?}"
+            );
+        }
+    }
+
+    fn plan_files(dir: &std::path::Path, out: &mut Vec<std::path::PathBuf>) {
+        for e in std::fs::read_dir(dir).unwrap() {
+            let path = e.unwrap().path();
+            if path.is_dir() {
+                plan_files(&path, out);
+            } else if path
+                .extension()
+                .is_some_and(|x| x == "plan" || x == "tplan" || x == "txt")
+            {
+                out.push(path);
+            }
+        }
+    }
+
+    #[test]
+    fn fast_and_careful_readers_agree_on_the_repositorys_plans() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+        let mut files = Vec::new();
+        plan_files(&root.join("examples"), &mut files);
+        plan_files(&root.join("tests/fixtures"), &mut files);
+        assert!(files.len() > 20, "{files:?}");
+        for f in &files {
+            let text = std::fs::read_to_string(f).unwrap();
+            assert_readers_agree(&text, &f.display().to_string());
+        }
+    }
+
+    const ODD_LINES: &[&str] = &[
+        "(move a b)",
+        "  (Move A-1 b_2 c.3 d@4)  ; note",
+        "(move a b) ;",
+        "(wait )",
+        "()",
+        "( )",
+        "(move a b",
+        "(move a b))",
+        "(move (a) b)",
+        "(move a\u{e9} b)",
+        "(MOVE \u{c9}t\u{c9} b)",
+        "(move \"a\" b)",
+        "(move a:b c)",
+        "(move a b) x",
+        "(move a b)[1]",
+        "(move a b) [1] ;c",
+        "(move a b) [1] x",
+        "(move a b) [1",
+        "(move a b) [ 1 ]",
+        "(move a b) [D:1.00; C:4099.73]",
+        "(move a b) [-1]",
+        "(move a b) [1.]",
+        "(move a b) [.5]",
+        "(move a b) [1e3]",
+        "0: (move a b)",
+        "0:(move a b)[2]",
+        "0 : (move a b)",
+        "00.500: (move a b) [0.25]",
+        "1.: (move a b)",
+        ".5: (move a b)",
+        "+1: (move a b)",
+        "-1: (move a b)",
+        "1e2: (move a b)",
+        "1.2.3: (move a b)",
+        "2.001: (PICK_OP1 robot1 screwdriver tool_rack) [3.000]",
+        "2.001:\t(pick r s t)\t[3.000]\t",
+        "123456789012345678901234567890.5: (move a b) [1]",
+        "0.1234567890123456789: (move a b) [0.30000000000000004]",
+        "99999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999999: (a)",
+        "1: x",
+        "1: (x",
+        "1:",
+        "step 0: PICK-UP B",
+        "        1: STACK B A",
+        "Time: 0.01s",
+        "move a b",
+        "; cost = 4 (unit cost)",
+        ")",
+        "[",
+        "\u{c}(move a b)\u{c}",
+    ];
+
+    #[test]
+    fn fast_and_careful_readers_agree_on_odd_lines() {
+        for line in ODD_LINES {
+            assert_readers_agree(line, "odd line");
+        }
+        assert_readers_agree(&ODD_LINES.join("\n"), "odd lines");
+        assert_readers_agree(&ODD_LINES.join("\r\n"), "odd lines, CRLF");
+    }
+
+    /// Lines of random bytes from the characters the readers decide on.
+    #[test]
+    fn fast_and_careful_readers_agree_on_random_lines() {
+        let alphabet: Vec<char> = "(()) [];:.:0123456789aBz-_@\t\u{e9}\"+e".chars().collect();
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = |n: usize| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed % n as u64) as usize
+        };
+        let shapes = ["(a b)", "1.5: (a b) [2]", "0: (x)", ""];
+        for _ in 0..20_000 {
+            let mut line: String = shapes[next(shapes.len())].into();
+            for _ in 0..next(4) {
+                let at = line
+                    .char_indices()
+                    .map(|(i, _)| i)
+                    .nth(next(line.chars().count() + 1))
+                    .unwrap_or(line.len());
+                line.insert(at, alphabet[next(alphabet.len())]);
+            }
+            assert_readers_agree(&line, "random line");
+        }
+    }
+
+    #[test]
+    fn the_fast_path_reads_the_common_shapes() {
+        let at = quick::Place {
+            base: 0,
+            file: 0,
+            line: 1,
+        };
+        for line in [
+            "(move a b)",
+            "(move a b) ; comment",
+            "2.001: (PICK_OP1 robot1 screwdriver tool_rack) [3.000]",
+            "0:\t(load r h c1)\t[2]",
+        ] {
+            assert!(quick::step(line, at).is_some(), "{line}");
+        }
+    }
+
+    #[test]
+    fn decimals_read_as_parse_reads_them() {
+        let mut seed = 12345u64;
+        for _ in 0..100_000 {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let int = (seed >> 20) % 10u64.pow((seed % 11) as u32 + 1);
+            let frac_digits = ((seed >> 8) % 12) as usize;
+            let frac = (seed >> 30) % 10u64.pow(frac_digits as u32);
+            let s = if frac_digits == 0 {
+                format!("{int}")
+            } else {
+                format!("{int}.{frac:0frac_digits$}")
+            };
+            let want: f64 = s.parse().unwrap();
+            assert_eq!(
+                quick::decimal(s.as_bytes()).to_bits(),
+                want.to_bits(),
+                "{s}"
+            );
+        }
+        for s in [
+            "0.1",
+            "0.3",
+            "2.001",
+            "9007199254740993",
+            "123456789012345.6",
+            "0.000000000000001",
+        ] {
+            let want: f64 = s.parse().unwrap();
+            assert_eq!(
+                quick::decimal(s.as_bytes()).to_bits(),
+                want.to_bits(),
+                "{s}"
+            );
+        }
+    }
+
+    #[test]
+    fn lines_are_cut_as_split_cuts_them() {
+        for text in ["", "\n", "a", "a\n", "a\nb", "\n\na\r\n\nb\n", "é\nü"] {
+            let mut offset = 0;
+            let want: Vec<(usize, &str)> = text
+                .split('\n')
+                .map(|l| {
+                    let start = offset;
+                    offset += l.len() + 1;
+                    (start, l)
+                })
+                .collect();
+            assert_eq!(lines_of(text).collect::<Vec<_>>(), want, "{text:?}");
+        }
     }
 }

@@ -198,14 +198,25 @@ impl World {
 
     /// Applies changes: deletes first, then adds (an atom both deleted and
     /// added stays true), then numeric updates; derived atoms are recomputed.
-    pub fn apply(&self, s: &mut State, changes: Changes) {
-        for k in &changes.delete {
-            s.facts.remove(k);
+    pub fn apply(&self, s: &mut State, mut changes: Changes) {
+        self.apply_changes(s, &mut changes);
+    }
+
+    /// [`World::apply`], leaving `changes` empty but keeping its room for
+    /// the next changes (a replay gathers every step's in the same one).
+    pub fn apply_changes(&self, s: &mut State, changes: &mut Changes) {
+        for k in changes.delete.drain(..) {
+            s.facts.remove(&k);
         }
-        s.facts.extend(changes.add);
-        for (k, v) in changes.numeric {
+        // One at a time: changes are mostly a step's fact or two, for which
+        // `extend`'s reservation costs more than it saves.
+        for k in changes.add.drain(..) {
+            s.facts.insert(k);
+        }
+        for (k, v) in changes.numeric.drain(..) {
             s.fluents.insert(k, v);
         }
+        changes.numeric_errors.clear();
         self.close_derived(s);
     }
 }
