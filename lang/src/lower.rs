@@ -645,7 +645,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
             args: g
                 .args
                 .iter()
-                .map(|&o| object_names[o as usize].to_string())
+                .map(|&o| input.pix.object_names[o as usize].clone())
                 .collect(),
             time: step.time,
             duration: step.duration,

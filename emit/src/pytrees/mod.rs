@@ -587,24 +587,32 @@ impl<'a> Emitter<'a> {
     /// Leaves of the main tree with every call expanded (each tree counted
     /// once and multiplied, so this is linear in the IR).
     fn leaf_count(&self) -> usize {
-        let mut memo: HashMap<&str, usize> = HashMap::new();
+        /// Leaves per tree, and per child that steps share (each counted
+        /// once, however many steps repeat it).
+        #[derive(Default)]
+        struct Memo<'t> {
+            trees: HashMap<&'t str, usize>,
+            steps: rustc_hash::FxHashMap<*const Node, usize>,
+        }
         // Trees are counted in dependency order by recursion with a depth
         // bound (calls nest at most `MAX_CALL_DEPTH` deep).
-        fn count<'t>(
-            ir: &'t TreeIr,
-            n: &'t Node,
-            memo: &mut HashMap<&'t str, usize>,
-            depth: usize,
-        ) -> usize {
+        fn count<'t>(ir: &'t TreeIr, n: &'t Node, memo: &mut Memo<'t>, depth: usize) -> usize {
             match n {
                 Node::Leaf { .. } => 1,
                 Node::Control { children, .. } => {
                     children.iter().map(|c| count(ir, c, memo, depth)).sum()
                 }
                 Node::Decorator { child, .. } => count(ir, child, memo, depth),
-                Node::Step { child, .. } => count(ir, child, memo, depth),
+                Node::Step { child, .. } => {
+                    if let Some(&k) = memo.steps.get(&Arc::as_ptr(child)) {
+                        return k;
+                    }
+                    let k = count(ir, child, memo, depth);
+                    memo.steps.insert(Arc::as_ptr(child), k);
+                    k
+                }
                 Node::SubTree { id, .. } => {
-                    if let Some(&k) = memo.get(id.as_str()) {
+                    if let Some(&k) = memo.trees.get(id.as_str()) {
                         return k;
                     }
                     let k = match ir.tree(id) {
@@ -613,12 +621,12 @@ impl<'a> Emitter<'a> {
                         }
                         _ => 1,
                     };
-                    memo.insert(id.as_str(), k);
+                    memo.trees.insert(id.as_str(), k);
                     k
                 }
             }
         }
-        count(self.ir, &self.ir.root, &mut memo, 0)
+        count(self.ir, &self.ir.root, &mut Memo::default(), 0)
     }
 }
 
