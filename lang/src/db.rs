@@ -1145,6 +1145,20 @@ mod compile_tests {
         }
         // Every P3 action but WAIT changes something at its end.
         assert_eq!(effects.len(), first.len() - 1);
+        // And their nodes below the step boundary are one node each.
+        let mut children = HashSet::new();
+        ir.root.walk(&mut |n| {
+            if let btc_ir::Node::Step { child, .. } = n {
+                children.insert(Arc::as_ptr(child));
+            }
+        });
+        let skipped: HashSet<_> = ir
+            .steps
+            .iter()
+            .filter(|s| s.skipped)
+            .map(|s| (s.action.as_str(), s.args.as_slice()))
+            .collect();
+        assert_eq!(children.len(), first.len() - skipped.len());
         assert!(first.len() < 20, "{} distinct ground actions", first.len());
     }
 }

@@ -1,0 +1,96 @@
+//! Steps that repeat a ground action share their logic and their node in
+//! the IR, and the emitters write a shared value once and copy it. The
+//! output must not depend on that: each emitter writes the same text for
+//! the compiled IR as for a copy of it in which nothing is shared (the IR
+//! read back from its JSON, where every step has its own values).
+
+use btc_emit::{emit, pytrees::Runtime, Format, Options};
+use btc_ir::TreeIr;
+use btc_lang::db::{compile, CompileJob, Database};
+use std::path::Path;
+
+fn read(p: &str) -> String {
+    let root = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/.."));
+    std::fs::read_to_string(root.join(p)).unwrap_or_else(|e| panic!("{p}: {e}"))
+}
+
+/// Compiles `rules` (a path) with the plan text `plan` for `problem`.
+fn compiled(dir: &str, rules: &str, problem: &str, plan: String) -> TreeIr {
+    let mut db = Database::new();
+    db.set_file(
+        &format!("{dir}/domain.pddl"),
+        read(&format!("{dir}/domain.pddl")),
+    );
+    for f in
+        std::fs::read_dir(Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/..")).join(dir)).unwrap()
+    {
+        let name = f.unwrap().file_name().to_string_lossy().into_owned();
+        if name.ends_with(".btrules") && name != rules {
+            db.set_file(&format!("{dir}/{name}"), read(&format!("{dir}/{name}")));
+        }
+    }
+    let r = db.set_file(&format!("{dir}/{rules}"), read(&format!("{dir}/{rules}")));
+    let p = db.set_file(
+        &format!("{dir}/{problem}"),
+        read(&format!("{dir}/{problem}")),
+    );
+    let l = db.set_file(&format!("{dir}/plan.txt"), plan);
+    let job = CompileJob::new(&db, r, l, Some(p), None);
+    compile(&db, job)
+        .clone()
+        .unwrap_or_else(|e| panic!("{dir}/{rules}: {e:#?}"))
+}
+
+/// The IR with nothing shared: every step's logic and node its own.
+fn unshared(ir: &TreeIr) -> TreeIr {
+    serde_json::from_str(&serde_json::to_string(ir).unwrap()).unwrap()
+}
+
+fn same_output(what: &str, ir: &TreeIr) {
+    let copy = unshared(ir);
+    assert_eq!(&copy, ir, "{what}: the JSON copy is the same IR");
+    for &(format, _) in Format::ALL {
+        for inline in [false, true] {
+            let options = Options {
+                inline,
+                runtime: Runtime::Import,
+                ..Options::default()
+            };
+            assert!(
+                emit(ir, format, &options) == emit(&copy, format, &options),
+                "{what}: {} (inline: {inline}) writes a shared step differently",
+                format.name()
+            );
+        }
+    }
+}
+
+#[test]
+fn a_long_plan_emits_as_its_unshared_copy() {
+    let ir = compiled(
+        "examples/p3_assembler",
+        "rules.btrules",
+        "problem.pddl",
+        btc_testkit::long_p3_plan(300),
+    );
+    same_output("P3, 300 steps", &ir);
+}
+
+#[test]
+fn every_step_arrangement_emits_as_its_unshared_copy() {
+    let dir = "lang/tests/fixtures/pytrees/workshop";
+    // The plan twice over is not a valid plan, but it compiles in order
+    // and in parallel (lowering does not replay it), and it repeats every
+    // ground action. `steps backchained` regresses the goal through the
+    // plan, so it gets the plan once.
+    let plan = read(&format!("{dir}/plan.txt"));
+    let twice = format!("{plan}{plan}");
+    for (rules, plan) in [
+        ("in_order.btrules", &twice),
+        ("parallel.btrules", &twice),
+        ("backchained.btrules", &plan),
+    ] {
+        let ir = compiled(dir, rules, "problem.pddl", plan.clone());
+        same_output(&format!("workshop {rules}"), &ir);
+    }
+}
