@@ -314,7 +314,7 @@ fn node(x: &mut Xml, n: &Node, ir: &TreeIr) {
                 if let Some(s) = info {
                     out.push_str(": (");
                     escape_attr_into(out, &s.action);
-                    for a in &s.args {
+                    for a in s.args.iter() {
                         out.push(' ');
                         escape_attr_into(out, a);
                     }

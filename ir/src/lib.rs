@@ -246,12 +246,12 @@ pub struct StepInfo {
     pub index: usize,
     /// 1-based line in the plan file.
     pub line: u32,
-    pub action: String,
-    pub args: Vec<String>,
+    pub action: Arc<str>,
+    pub args: Arc<[String]>,
     pub time: Option<f64>,
     pub duration: Option<f64>,
     /// The id of the rule tree it calls; `None` for a skipped step.
-    pub rule: Option<String>,
+    pub rule: Option<Arc<str>>,
     pub skipped: bool,
     /// Ground conditions and effects, by when they apply. The effects are
     /// the step's: its rule's `effect` when the rule gives one, else the
@@ -271,7 +271,7 @@ impl StepInfo {
     /// `(action arg ...)`
     pub fn display(&self) -> String {
         let mut s = format!("({}", self.action);
-        for a in &self.args {
+        for a in self.args.iter() {
             s.push(' ');
             s.push_str(a);
         }

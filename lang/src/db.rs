@@ -1135,9 +1135,7 @@ mod compile_tests {
         let mut first: HashMap<(&str, &[String]), &btc_ir::StepInfo> = HashMap::new();
         let mut effects = HashSet::new();
         for s in &ir.steps {
-            let f = first
-                .entry((s.action.as_str(), s.args.as_slice()))
-                .or_insert(s);
+            let f = first.entry((&*s.action, s.args.as_ref())).or_insert(s);
             assert!(same(&f.pre_start, &s.pre_start) && same(&f.pre_over_all, &s.pre_over_all));
             assert!(same(&f.pre_end, &s.pre_end) && same(&f.eff_start, &s.eff_start));
             assert!(same(&f.eff_end, &s.eff_end));
@@ -1156,7 +1154,7 @@ mod compile_tests {
             .steps
             .iter()
             .filter(|s| s.skipped)
-            .map(|s| (s.action.as_str(), s.args.as_slice()))
+            .map(|s| (&*s.action, s.args.as_ref()))
             .collect();
         assert_eq!(children.len(), first.len() - skipped.len());
         assert!(first.len() < 20, "{} distinct ground actions", first.len());

@@ -61,6 +61,8 @@ impl ObjectTypes for Types<'_> {
 /// value expression a call evaluates.
 struct RuleTree {
     id: String,
+    /// The id as the steps that call the tree hold it (one for all).
+    shared_id: Arc<str>,
     params: Vec<(String, Value)>,
     root: Node,
     typed: Vec<TypedPort>,
@@ -597,7 +599,7 @@ fn rule_id(r: &Rule, taken: &BTreeSet<String>) -> String {
 /// its effects (a rule's `effect` replaces the action's) and the step's
 /// node below its `Step` boundary.
 struct Lowered {
-    rule: Option<String>,
+    rule: Option<Arc<str>>,
     eff_start: Option<Arc<logic::Effect>>,
     eff_end: Option<Arc<logic::Effect>>,
     child: Option<Arc<Node>>,
@@ -616,6 +618,10 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
     // rule, which tree call and guard, which effects depend on the action
     // and its objects only, never on the step's place in the plan.
     let mut lowered: rustc_hash::FxHashMap<(usize, &[u32]), Lowered> = Default::default();
+    // Steps with the same objects share their names, and with the same
+    // action its name.
+    let mut action_names: rustc_hash::FxHashMap<usize, Arc<str>> = Default::default();
+    let mut arg_names: rustc_hash::FxHashMap<&[u32], Arc<[String]>> = Default::default();
     let mut rule_effects: BTreeMap<usize, RuleEffect> = BTreeMap::new();
     let mut rule_trees: Vec<(usize, RuleTree)> = Vec::new(); // by rule index
     let mut taken = BTreeSet::new();
@@ -641,12 +647,19 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
         let mut info = StepInfo {
             index: k,
             line: step.line,
-            action: action.name.name.clone(),
-            args: g
-                .args
-                .iter()
-                .map(|&o| input.pix.object_names[o as usize].clone())
-                .collect(),
+            action: action_names
+                .entry(g.action)
+                .or_insert_with(|| action.name.name.as_str().into())
+                .clone(),
+            args: arg_names
+                .entry(g.args.as_slice())
+                .or_insert_with(|| {
+                    g.args
+                        .iter()
+                        .map(|&o| input.pix.object_names[o as usize].clone())
+                        .collect()
+                })
+                .clone(),
             time: step.time,
             duration: step.duration,
             rule: None,
@@ -783,6 +796,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
                 rule_trees.push((
                     ri,
                     RuleTree {
+                        shared_id: id.as_str().into(),
                         id,
                         params: inst.params.unwrap_or_default(),
                         typed: typed_ports(&root, input),
@@ -862,7 +876,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
             );
             },
         );
-        info.rule = Some(rt.id.clone());
+        info.rule = Some(rt.shared_id.clone());
         let mut child = Node::SubTree {
             scripts: Default::default(),
             id: rt.id.clone(),

@@ -298,7 +298,7 @@ impl<'a> Emitter<'a> {
             Default::default();
         let mut buf = String::new();
         for s in &self.ir.steps {
-            let logic = (s.action.as_str(), s.args.as_slice(), logic_addresses(s));
+            let logic = (&*s.action, s.args.as_ref(), logic_addresses(s));
             if let Some(&k) = by_logic.get(&logic) {
                 of_step.push(k);
                 continue;
@@ -684,7 +684,7 @@ fn row_of(s: &StepInfo, shape: usize, out: &mut String) {
     out.push_str("    (");
     push_int(out, shape);
     out.push_str(", (");
-    for a in &s.args {
+    for a in s.args.iter() {
         push_py_str(out, a);
         out.push_str(", ");
     }
