@@ -95,7 +95,15 @@ struct Xml {
     /// Steps' nodes as XML, by the address of the shared node and the
     /// depth they were written at.
     step_nodes: rustc_hash::FxHashMap<(usize, usize), Box<str>>,
+    /// The plan's steps, how many are written, and where the first began:
+    /// see [`Xml::step_written`].
+    steps: usize,
+    steps_written: usize,
+    steps_from: usize,
 }
+
+/// Steps written before the buffer is sized for the rest.
+const SAMPLE_STEPS: usize = 256;
 
 impl Xml {
     fn new(capacity: usize) -> Xml {
@@ -107,6 +115,24 @@ impl Xml {
             scratch: String::new(),
             shared: Default::default(),
             step_nodes: Default::default(),
+            steps: 0,
+            steps_written: 0,
+            steps_from: 0,
+        }
+    }
+
+    /// Sizes the buffer for the rest of the plan once the first steps are
+    /// written, at the rate they took: a step's size follows its names,
+    /// which no estimate made up front knows, and a buffer of tens of
+    /// megabytes grown by doubling costs more (copies, fresh pages) than
+    /// writing it.
+    fn step_written(&mut self) {
+        self.steps_written += 1;
+        if self.steps_written == SAMPLE_STEPS && self.steps > 2 * SAMPLE_STEPS {
+            let per_step = (self.out.len() - self.steps_from) / SAMPLE_STEPS;
+            let rest = (self.steps - SAMPLE_STEPS) * per_step;
+            // A twentieth to spare, and room for the rule trees and models.
+            self.out.reserve(rest + rest / 20 + 65_536);
         }
     }
 
@@ -307,6 +333,9 @@ fn node(x: &mut Xml, n: &Node, ir: &TreeIr) {
             x.close(true);
         }
         Node::Step { step, child } => {
+            if x.steps_written == 0 {
+                x.steps_from = x.out.len();
+            }
             let info = ir.steps.get(*step);
             x.open("KbStep").attr_with("name", |out| {
                 out.push_str("step ");
@@ -341,6 +370,7 @@ fn node(x: &mut Xml, n: &Node, ir: &TreeIr) {
             x.close(false);
             shared_node(x, child, ir);
             x.end("KbStep");
+            x.step_written();
         }
     }
 }
@@ -361,10 +391,10 @@ fn shared_node(x: &mut Xml, n: &Arc<Node>, ir: &TreeIr) {
 
 /// The XML document for a compiled plan.
 pub fn emit(ir: &TreeIr, inline: bool) -> String {
-    // Sized up front: growing a buffer of tens of megabytes by doubling
-    // costs more (copies, fresh pages) than writing it.
-    let estimate = 4096 + ir.steps.len() * 320 + ir.trees.len() * 2048;
+    // Room for the first steps; the rest is sized as they are written.
+    let estimate = 4096 + ir.steps.len().min(SAMPLE_STEPS) * 512 + ir.trees.len() * 2048;
     let mut x = Xml::new(estimate);
+    x.steps = ir.steps.len();
     x.open("root")
         .attr("BTCPP_format", "4")
         .attr("main_tree_to_execute", &ir.main_tree)
