@@ -6,6 +6,7 @@
 //!
 //! `SubTree` elements get no `name` attribute: Groot2's monitor crashes on it.
 
+use crate::sizing::{StepSizer, SAMPLE_STEPS};
 use btc_ir::*;
 use std::fmt::Write as _;
 use std::sync::Arc;
@@ -95,15 +96,9 @@ struct Xml {
     /// Steps' nodes as XML, by the address of the shared node and the
     /// depth they were written at.
     step_nodes: rustc_hash::FxHashMap<(usize, usize), Box<str>>,
-    /// The plan's steps, how many are written, and where the first began:
-    /// see [`Xml::step_written`].
-    steps: usize,
-    steps_written: usize,
-    steps_from: usize,
+    /// Sizes the buffer by the plan's first steps.
+    sizer: StepSizer,
 }
-
-/// Steps written before the buffer is sized for the rest.
-const SAMPLE_STEPS: usize = 256;
 
 impl Xml {
     fn new(capacity: usize) -> Xml {
@@ -115,24 +110,7 @@ impl Xml {
             scratch: String::new(),
             shared: Default::default(),
             step_nodes: Default::default(),
-            steps: 0,
-            steps_written: 0,
-            steps_from: 0,
-        }
-    }
-
-    /// Sizes the buffer for the rest of the plan once the first steps are
-    /// written, at the rate they took: a step's size follows its names,
-    /// which no estimate made up front knows, and a buffer of tens of
-    /// megabytes grown by doubling costs more (copies, fresh pages) than
-    /// writing it.
-    fn step_written(&mut self) {
-        self.steps_written += 1;
-        if self.steps_written == SAMPLE_STEPS && self.steps > 2 * SAMPLE_STEPS {
-            let per_step = (self.out.len() - self.steps_from) / SAMPLE_STEPS;
-            let rest = (self.steps - SAMPLE_STEPS) * per_step;
-            // A twentieth to spare, and room for the rule trees and models.
-            self.out.reserve(rest + rest / 20 + 65_536);
+            sizer: StepSizer::new(0),
         }
     }
 
@@ -333,9 +311,7 @@ fn node(x: &mut Xml, n: &Node, ir: &TreeIr) {
             x.close(true);
         }
         Node::Step { step, child } => {
-            if x.steps_written == 0 {
-                x.steps_from = x.out.len();
-            }
+            x.sizer.start(&x.out);
             let info = ir.steps.get(*step);
             x.open("KbStep").attr_with("name", |out| {
                 out.push_str("step ");
@@ -370,7 +346,8 @@ fn node(x: &mut Xml, n: &Node, ir: &TreeIr) {
             x.close(false);
             shared_node(x, child, ir);
             x.end("KbStep");
-            x.step_written();
+            // Room after the steps for the rule trees and the models.
+            x.sizer.written(&mut x.out, 65_536);
         }
     }
 }
@@ -394,7 +371,7 @@ pub fn emit(ir: &TreeIr, inline: bool) -> String {
     // Room for the first steps; the rest is sized as they are written.
     let estimate = 4096 + ir.steps.len().min(SAMPLE_STEPS) * 512 + ir.trees.len() * 2048;
     let mut x = Xml::new(estimate);
-    x.steps = ir.steps.len();
+    x.sizer = StepSizer::new(ir.steps.len());
     x.open("root")
         .attr("BTCPP_format", "4")
         .attr("main_tree_to_execute", &ir.main_tree)

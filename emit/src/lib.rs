@@ -8,6 +8,7 @@ pub mod dot;
 pub mod executor;
 pub mod kb;
 pub mod pytrees;
+mod sizing;
 
 use btc_ir::TreeIr;
 

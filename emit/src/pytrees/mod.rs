@@ -17,6 +17,7 @@
 mod encode;
 pub mod names;
 
+use crate::sizing::{StepSizer, SAMPLE_STEPS};
 use btc_ir::vocab::{NodeSpec, PyTrees};
 use btc_ir::Count;
 use btc_ir::{
@@ -105,12 +106,16 @@ struct Emitter<'a> {
     /// Steps' nodes as Python, by the address of the shared node and the
     /// indent they were written at.
     step_nodes: std::cell::RefCell<rustc_hash::FxHashMap<(usize, usize), Box<str>>>,
+    /// Sizes the buffer by the main tree's first steps.
+    root_sizer: std::cell::RefCell<StepSizer>,
 }
 
 pub fn emit(ir: &TreeIr, options: &PyOptions<'_>) -> String {
     let mut e = Emitter {
         ir,
-        out: String::with_capacity(256 * ir.steps.len() + 16_384),
+        // Room for the first steps: the rows and the main tree are sized
+        // by them as they are written.
+        out: String::with_capacity(256 * ir.steps.len().min(SAMPLE_STEPS) + 16_384),
         classes: HashMap::new(),
         trees: ir
             .trees
@@ -120,6 +125,7 @@ pub fn emit(ir: &TreeIr, options: &PyOptions<'_>) -> String {
             .collect(),
         encoded: Default::default(),
         step_nodes: Default::default(),
+        root_sizer: std::cell::RefCell::new(StepSizer::new(ir.steps.len())),
     };
     e.header(options);
     e.world();
@@ -330,8 +336,12 @@ impl<'a> Emitter<'a> {
             o.push_str(",\n");
         }
         o.push_str(")\n\nSTEPS = (\n");
+        let mut rows = StepSizer::new(self.ir.steps.len());
         for (s, k) in self.ir.steps.iter().zip(of_step) {
+            rows.start(o);
             row_of(s, k, o);
+            // Room after the rows for the leaf classes and the rule trees.
+            rows.written(o, 65_536);
         }
         o.push_str(")\n\nPLAN = Plan(SHAPES, STEPS)\n");
     }
@@ -492,11 +502,14 @@ impl<'a> Emitter<'a> {
                 o.push(')');
             }
             Node::Step { step, child } => {
+                self.root_sizer.borrow_mut().start(o);
                 o.push_str("(\"S\", ");
                 push_int(o, *step);
                 o.push_str(", ");
                 self.shared_node(child, o, indent);
                 o.push(')');
+                // Room after the steps for the module's end.
+                self.root_sizer.borrow_mut().written(o, 4096);
             }
             Node::SubTree { id, ports, .. } => match self.trees.get(id.as_str()) {
                 Some(&t) => {
