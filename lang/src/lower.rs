@@ -594,7 +594,6 @@ fn rule_id(r: &Rule, taken: &BTreeSet<String>) -> String {
     id
 }
 
-/// Lowers a plan; every problem is reported at the plan line of its step.
 /// How a ground action lowers: the rule tree it calls (`None`: skipped),
 /// its effects (a rule's `effect` replaces the action's) and the step's
 /// node below its `Step` boundary.
@@ -605,6 +604,7 @@ struct Lowered {
     child: Option<Arc<Node>>,
 }
 
+/// Lowers a plan; every problem is reported at the plan line of its step.
 pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
     let mut diags = Vec::new();
     let types = Types {
@@ -613,7 +613,6 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
     };
     let tables = |name: &str| input.decls.tables.get(name).cloned();
     let mut grounder = Grounder::default();
-    let mut guard_names: rustc_hash::FxHashMap<usize, Label> = Default::default();
     // Each ground action's lowering, for the steps that repeat it: which
     // rule, which tree call and guard, which effects depend on the action
     // and its objects only, never on the step's place in the plan.
@@ -883,16 +882,10 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
             ports,
         };
         if let Some(over) = &info.pre_over_all {
-            // Steps that repeat a ground action share its condition, and
-            // their guard's name with it.
-            let name = guard_names
-                .entry(Arc::as_ptr(over) as usize)
-                .or_insert_with(|| Label::from(format!("while {over}")))
-                .clone();
             child = Node::Control {
                 scripts: Default::default(),
                 control: ControlKind::ReactiveSequence,
-                name: Some(name),
+                name: Some(format!("while {over}").into()),
                 children: vec![kb_holds(over.clone(), None), child],
             };
         }

@@ -20,9 +20,7 @@ pub mod names;
 use crate::sizing::{StepSizer, SAMPLE_STEPS};
 use btc_ir::vocab::{NodeSpec, PyTrees};
 use btc_ir::Count;
-use btc_ir::{
-    push_int, Label, LabelPart, LeafKind, Node, NodeModel, Port, PortValue, StepInfo, TreeIr,
-};
+use btc_ir::{push_int, Label, LabelPart, LeafKind, Node, NodeModel, Port, StepInfo, TreeIr};
 use btc_pddl::logic::InitFact;
 use names::{is_plain_kwarg, RESERVED};
 pub use names::{push_py_str, py_ident, py_str, Names};
@@ -98,13 +96,10 @@ struct Emitter<'a> {
     out: String,
     classes: HashMap<&'a str, LeafClass>,
     trees: HashMap<&'a str, usize>,
-    /// Formula and effect ports as Python, by the address of their shared
-    /// value: the steps that repeat a ground action share its guard, which
-    /// is encoded once. (The IR is borrowed for the whole emit, so an
-    /// address names one value.)
-    encoded: std::cell::RefCell<rustc_hash::FxHashMap<usize, Box<str>>>,
     /// Steps' nodes as Python, by the address of the shared node and the
-    /// indent they were written at.
+    /// indent they were written at: the steps that repeat a ground action
+    /// share it, and it is written once. (The IR is borrowed for the whole
+    /// emit, so an address names one value.)
     step_nodes: std::cell::RefCell<rustc_hash::FxHashMap<(usize, usize), Box<str>>>,
     /// Sizes the buffer by the main tree's first steps.
     root_sizer: std::cell::RefCell<StepSizer>,
@@ -123,7 +118,6 @@ pub fn emit(ir: &TreeIr, options: &PyOptions<'_>) -> String {
             .enumerate()
             .map(|(i, t)| (t.id.as_str(), i))
             .collect(),
-        encoded: Default::default(),
         step_nodes: Default::default(),
         root_sizer: std::cell::RefCell::new(StepSizer::new(ir.steps.len())),
     };
@@ -521,7 +515,7 @@ impl<'a> Emitter<'a> {
                         push_int(o, t);
                         o.push_str(", (");
                         for p in ports {
-                            self.port_value(&p.value, o);
+                            encode::port_value(&p.value, o);
                             o.push_str(", ");
                         }
                         o.push_str("))");
@@ -557,27 +551,10 @@ impl<'a> Emitter<'a> {
             o.push('(');
             push_py_str(o, &p.name);
             o.push_str(", ");
-            self.port_value(&p.value, o);
+            encode::port_value(&p.value, o);
             o.push_str("), ");
         }
         o.push(')');
-    }
-
-    /// A port's value as Python; a shared formula or effect is encoded
-    /// once.
-    fn port_value(&self, v: &PortValue, o: &mut String) {
-        let key = match v {
-            PortValue::Formula(f) => Arc::as_ptr(f) as usize,
-            PortValue::Effect(e) => Arc::as_ptr(e) as usize,
-            _ => return encode::port_value(v, o),
-        };
-        let mut memo = self.encoded.borrow_mut();
-        let text = memo.entry(key).or_insert_with(|| {
-            let mut s = String::new();
-            encode::port_value(v, &mut s);
-            s.into()
-        });
-        o.push_str(text);
     }
 
     fn footer(&mut self) {
