@@ -89,7 +89,7 @@ fn plan_steps(plan: &Path) -> Vec<(Name, Vec<Name>)> {
     let n = |x: &btc_pddl::ast::Name| btc_pddl::logic::name(&x.name);
     plan.steps
         .iter()
-        .map(|s| (n(&s.action), s.args.iter().map(n).collect()))
+        .map(|s| (n(&s.action()), s.args().map(|a| n(&a)).collect()))
         .collect()
 }
 

@@ -12,7 +12,7 @@ use std::fmt::Write as _;
 use std::sync::Arc;
 
 /// Whether a character must be escaped (or replaced) in an attribute value.
-fn needs_escape(c: char) -> bool {
+const fn needs_escape(c: char) -> bool {
     matches!(
         c,
         '&' | '<' | '>' | '"' | '\'' | '\u{0}'..='\u{1F}' | '\u{FFFE}' | '\u{FFFF}'
@@ -23,29 +23,51 @@ fn needs_escape(c: char) -> bool {
 /// character references (a parser would fold them into spaces otherwise);
 /// characters XML 1.0 forbids become U+FFFD.
 pub fn escape_attr_into(out: &mut String, s: &str) {
-    // Runs of plain text are copied whole; only the rare specials are
-    // looked at one by one.
-    let mut plain_from = 0;
-    for (i, c) in s.char_indices() {
-        if !needs_escape(c) {
+    // Runs of plain text are copied whole; bytes are classed by a table
+    // (a long plan's attributes are nearly all plain ASCII), and only a
+    // flagged byte is looked at as a character.
+    let b = s.as_bytes();
+    let (mut plain_from, mut i) = (0, 0);
+    while i < b.len() {
+        if !FLAGGED[b[i] as usize] {
+            i += 1;
             continue;
         }
-        out.push_str(&s[plain_from..i]);
-        plain_from = i + c.len_utf8();
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&apos;"),
-            '\n' => out.push_str("&#10;"),
-            '\r' => out.push_str("&#13;"),
-            '\t' => out.push_str("&#9;"),
-            _ => out.push('\u{FFFD}'),
+        // A flagged byte starts a character: ASCII, or U+EFxx's lead byte.
+        let c = s[i..].chars().next().expect("a character starts here");
+        let len = c.len_utf8();
+        if needs_escape(c) {
+            out.push_str(&s[plain_from..i]);
+            plain_from = i + len;
+            match c {
+                '&' => out.push_str("&amp;"),
+                '<' => out.push_str("&lt;"),
+                '>' => out.push_str("&gt;"),
+                '"' => out.push_str("&quot;"),
+                '\'' => out.push_str("&apos;"),
+                '\n' => out.push_str("&#10;"),
+                '\r' => out.push_str("&#13;"),
+                '\t' => out.push_str("&#9;"),
+                _ => out.push('\u{FFFD}'),
+            }
         }
+        i += len;
     }
     out.push_str(&s[plain_from..]);
 }
+
+/// The bytes that may start a character [`needs_escape`] takes: the ASCII
+/// ones, and 0xEF, the lead byte of U+FFFE and U+FFFF.
+static FLAGGED: [bool; 256] = {
+    let mut t = [false; 256];
+    let mut i = 0;
+    while i < 128 {
+        t[i] = needs_escape(i as u8 as char);
+        i += 1;
+    }
+    t[0xEF] = true;
+    t
+};
 
 /// [`escape_attr_into`] as a value; borrows when nothing needs escaping.
 pub fn escape_attr(s: &str) -> std::borrow::Cow<'_, str> {
@@ -96,6 +118,9 @@ struct Xml {
     /// Steps' nodes as XML, by the address of the shared node and the
     /// depth they were written at.
     step_nodes: rustc_hash::FxHashMap<(usize, usize), Box<str>>,
+    /// Steps' `(action arg ...)` as escaped text, by the addresses of the
+    /// shared action and arguments.
+    step_calls: rustc_hash::FxHashMap<(usize, usize), Box<str>>,
     /// Sizes the buffer by the plan's first steps.
     sizer: StepSizer,
 }
@@ -110,6 +135,7 @@ impl Xml {
             scratch: String::new(),
             shared: Default::default(),
             step_nodes: Default::default(),
+            step_calls: Default::default(),
             sizer: StepSizer::new(0),
         }
     }
@@ -313,19 +339,27 @@ fn node(x: &mut Xml, n: &Node, ir: &TreeIr) {
         Node::Step { step, child } => {
             x.sizer.start(&x.out);
             let info = ir.steps.get(*step);
-            x.open("KbStep").attr_with("name", |out| {
-                out.push_str("step ");
-                push_int(out, step + 1);
-                if let Some(s) = info {
-                    out.push_str(": (");
-                    escape_attr_into(out, &s.action);
+            x.open("KbStep");
+            x.out.push_str(" name=\"step ");
+            push_int(&mut x.out, step + 1);
+            if let Some(s) = info {
+                let key = (
+                    Arc::as_ptr(&s.action) as *const u8 as usize,
+                    Arc::as_ptr(&s.args) as *const u8 as usize,
+                );
+                let call = x.step_calls.entry(key).or_insert_with(|| {
+                    let mut out = String::from(": (");
+                    escape_attr_into(&mut out, &s.action);
                     for a in s.args.iter() {
                         out.push(' ');
-                        escape_attr_into(out, a);
+                        escape_attr_into(&mut out, a);
                     }
                     out.push(')');
-                }
-            });
+                    out.into()
+                });
+                x.out.push_str(call);
+            }
+            x.out.push('"');
             integer(x, "step", step + 1);
             x.attr_shared("start_effect", info.and_then(|s| s.eff_start.as_ref()))
                 .attr_shared("end_effect", info.and_then(|s| s.eff_end.as_ref()));
@@ -478,6 +512,48 @@ mod tests {
         assert_eq!(escape_attr("</BehaviorTree>"), "&lt;/BehaviorTree&gt;");
         assert_eq!(escape_attr("x\u{1}y"), "x\u{FFFD}y");
         assert_eq!(escape_attr("日本ü"), "日本ü");
+    }
+
+    /// The table-driven scan escapes as a look at every character does,
+    /// on strings mixing specials, controls, U+FFFE/U+FFFF and the other
+    /// characters whose first byte is 0xEF.
+    #[test]
+    fn the_byte_scan_agrees_with_a_character_scan() {
+        let pieces = [
+            "a", "&", "<", ">", "\"", "'", "\n", "\r", "\t", "\u{1}", "\u{1F}", " ", "\u{7F}", "ü",
+            "日", "\u{FFFE}", "\u{FFFF}", "\u{FFFD}", "\u{F000}", "\u{FEFF}", "🦀",
+        ];
+        let reference = |s: &str| -> String {
+            s.chars()
+                .map(|c| match c {
+                    '&' => "&amp;".to_owned(),
+                    '<' => "&lt;".to_owned(),
+                    '>' => "&gt;".to_owned(),
+                    '"' => "&quot;".to_owned(),
+                    '\'' => "&apos;".to_owned(),
+                    '\n' => "&#10;".to_owned(),
+                    '\r' => "&#13;".to_owned(),
+                    '\t' => "&#9;".to_owned(),
+                    c if needs_escape(c) => "\u{FFFD}".to_owned(),
+                    c => c.to_string(),
+                })
+                .collect()
+        };
+        // Every string of up to three pieces.
+        let n = pieces.len();
+        for k in 0..n * n * n + n * n + n {
+            let (mut s, mut k) = (String::new(), k);
+            loop {
+                s.push_str(pieces[k % n]);
+                if k < n {
+                    break;
+                }
+                k = k / n - 1;
+            }
+            let mut out = String::new();
+            escape_attr_into(&mut out, &s);
+            assert_eq!(out, reference(&s), "{s:?}");
+        }
     }
 
     #[test]

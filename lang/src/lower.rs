@@ -642,7 +642,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
         let step = &input.plan.steps[g.step];
         let action = &input.domain.actions[g.action];
         let ground = grounder.ground(input.domain, g.action, &g.args, &object_names);
-        let repeated = lowered.get(&(g.action, g.args.as_slice()));
+        let repeated = lowered.get(&(g.action, &g.args[..]));
         let mut info = StepInfo {
             index: k,
             line: step.line,
@@ -651,7 +651,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
                 .or_insert_with(|| action.name.name.as_str().into())
                 .clone(),
             args: arg_names
-                .entry(g.args.as_slice())
+                .entry(&g.args[..])
                 .or_insert_with(|| {
                     g.args
                         .iter()
@@ -730,7 +730,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
         let RuleBody::Template { body, effect } = &rule.body else {
             info.skipped = true;
             lowered.insert(
-                (g.action, g.args.as_slice()),
+                (g.action, &g.args[..]),
                 Lowered {
                     rule: None,
                     eff_start: info.eff_start.clone(),
@@ -893,7 +893,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
         // A step with a diagnostic is not reused: each step reports its own.
         if diags.len() == diags_before {
             lowered.insert(
-                (g.action, g.args.as_slice()),
+                (g.action, &g.args[..]),
                 Lowered {
                     rule: info.rule.clone(),
                     eff_start: info.eff_start.clone(),

@@ -68,7 +68,7 @@ fn literal_names_are_looked_up_not_scanned() {
         |(domain, index)| {
             for a in &domain.actions {
                 let parts = [NamePart::Lit {
-                    text: a.name.name.clone(),
+                    text: a.name.name.to_string(),
                     key: Key::of_pddl(&a.name.name),
                     span: Span::new(0, 0, 0),
                 }];

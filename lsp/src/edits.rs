@@ -90,7 +90,7 @@ fn port_name(var: &str) -> String {
 
 fn port_type(t: &TypeSpec) -> String {
     match t {
-        TypeSpec::Named { name } => name.name.clone(),
+        TypeSpec::Named { name } => name.name.to_string(),
         TypeSpec::Object | TypeSpec::Either { .. } => "object".into(),
     }
 }
@@ -146,7 +146,7 @@ pub fn rule_stubs(a: &Analysis) -> Option<String> {
             .map(|p| format!("{}: ?{}", port_name(&p.name.name), p.name.name))
             .collect();
         let head = if vars.is_empty() {
-            act.name.name.clone()
+            act.name.name.to_string()
         } else {
             format!("{} {}", act.name.name, vars.join(" "))
         };

@@ -3,10 +3,14 @@
 
 use crate::source::Span;
 use serde::{Deserialize, Serialize};
+pub use smol_str::SmolStr;
 
+/// A name as written (lower-cased) and where. The text is a [`SmolStr`]:
+/// PDDL names are short, so they live inline, and a long plan's thousands
+/// of repeated object names cost no allocation each.
 #[derive(Clone, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub struct Name {
-    pub name: String,
+    pub name: SmolStr,
     pub span: Span,
 }
 

@@ -269,9 +269,9 @@ pub fn check_domain(domain: &Domain) -> (DomainIndex, Vec<Diagnostic>) {
             continue;
         }
         let id = index.constant_names.len() as u32;
-        index.constant_names.push(c.name.name.clone());
+        index.constant_names.push(c.name.name.to_string());
         index.constants.insert(
-            c.name.name.clone(),
+            c.name.name.to_string(),
             ObjectInfo {
                 id,
                 types,
@@ -339,7 +339,7 @@ pub fn check_domain(domain: &Domain) -> (DomainIndex, Vec<Diagnostic>) {
             ),
             Some(_) => {}
         }
-        index.derived.insert(d.head.name.name.clone());
+        index.derived.insert(d.head.name.name.to_string());
     }
     index.derived_strata = stratify(domain, &index, &mut diags);
 
@@ -424,10 +424,10 @@ pub fn check_problem(
             continue;
         }
         let id = pi.object_names.len() as u32;
-        pi.object_names.push(o.name.name.clone());
+        pi.object_names.push(o.name.name.to_string());
         pi.object_types.push(types.clone());
         pi.objects.insert(
-            o.name.name.clone(),
+            o.name.name.to_string(),
             ObjectInfo {
                 id,
                 types,
@@ -532,7 +532,12 @@ fn resolve_params(
 fn scope_of(params: &[Typed], types: &TypeTable) -> Scope {
     params
         .iter()
-        .map(|p| (p.name.name.clone(), types.resolve(&p.ty, &mut Vec::new())))
+        .map(|p| {
+            (
+                p.name.name.to_string(),
+                types.resolve(&p.ty, &mut Vec::new()),
+            )
+        })
         .collect()
 }
 
@@ -543,7 +548,7 @@ fn check_duplicate_vars(params: &[Typed], diags: &mut Vec<Diagnostic>) {
             diags.push(duplicate(
                 "parameter",
                 &Name {
-                    name: format!("?{}", p.name.name),
+                    name: smol_str::format_smolstr!("?{}", p.name.name),
                     span: p.name.span,
                 },
                 prev,
@@ -567,7 +572,7 @@ fn declare(
         return;
     }
     table.insert(
-        name.name.clone(),
+        name.name.to_string(),
         Signature {
             index,
             params,
@@ -822,7 +827,7 @@ impl Checker<'_> {
         let mut inner = scope.clone();
         for v in vars {
             inner.push((
-                v.name.name.clone(),
+                v.name.name.to_string(),
                 self.index.types.resolve(&v.ty, &mut self.diags),
             ));
             note_typed(v, &mut self.used);

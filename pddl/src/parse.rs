@@ -115,7 +115,7 @@ fn name_of(s: &Sexp) -> Option<Name> {
     match s {
         Sexp::Atom(t) => match &t.tok {
             Tok::Name(n) => Some(Name {
-                name: n.clone(),
+                name: n.into(),
                 span: t.span,
             }),
             _ => None,
@@ -128,7 +128,7 @@ fn var_of(s: &Sexp) -> Option<Name> {
     match s {
         Sexp::Atom(t) => match &t.tok {
             Tok::Var(n) => Some(Name {
-                name: n.clone(),
+                name: n.into(),
                 span: t.span,
             }),
             _ => None,
@@ -317,7 +317,7 @@ impl Parser {
         let mut p = Problem {
             name,
             domain: Name {
-                name: String::new(),
+                name: SmolStr::default(),
                 span,
             },
             requirements: Vec::new(),
@@ -375,7 +375,7 @@ impl Parser {
         for s in it.rest() {
             match s.keyword() {
                 Some(k) => out.push(Name {
-                    name: k.to_owned(),
+                    name: k.into(),
                     span: s.span(),
                 }),
                 None => self.expected("a requirement such as `:strips`", Some(s), s.span()),

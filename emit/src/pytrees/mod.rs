@@ -292,13 +292,13 @@ impl<'a> Emitter<'a> {
         // module after the shapes, not through a second buffer as large
         // as the plan.
         let mut of_step: Vec<usize> = Vec::with_capacity(self.ir.steps.len());
-        // Steps that repeat a ground action share its logic (the same
-        // values, not equal copies): their shape is found once.
-        let mut by_logic: rustc_hash::FxHashMap<(&str, &[String], [usize; 5]), usize> =
-            Default::default();
+        // Steps that repeat a ground action share its action, arguments
+        // and logic (the same values, not equal copies): their shape is
+        // found once, by the values' addresses.
+        let mut by_logic: rustc_hash::FxHashMap<[usize; 7], usize> = Default::default();
         let mut buf = String::new();
         for s in &self.ir.steps {
-            let logic = (&*s.action, s.args.as_ref(), logic_addresses(s));
+            let logic = logic_addresses(s);
             if let Some(&k) = by_logic.get(&logic) {
                 of_step.push(k);
                 continue;
@@ -331,9 +331,14 @@ impl<'a> Emitter<'a> {
         }
         o.push_str(")\n\nSTEPS = (\n");
         let mut rows = StepSizer::new(self.ir.steps.len());
+        // Each shared argument tuple as text, by its address.
+        let mut tuples: rustc_hash::FxHashMap<usize, Box<str>> = Default::default();
         for (s, k) in self.ir.steps.iter().zip(of_step) {
             rows.start(o);
-            row_of(s, k, o);
+            let args = tuples
+                .entry(Arc::as_ptr(&s.args) as *const u8 as usize)
+                .or_insert_with(|| args_tuple(&s.args).into());
+            row_of(s, k, args, o);
             // Room after the rows for the leaf classes and the rule trees.
             rows.written(o, 65_536);
         }
@@ -639,13 +644,15 @@ fn push_opt_name(o: &mut String, name: &Option<Label>) {
     }
 }
 
-/// Where a step's conditions and effects are (0 for none): two steps with
-/// the same addresses, action and arguments have the same shape.
-fn logic_addresses(s: &StepInfo) -> [usize; 5] {
+/// Where a step's action, arguments, conditions and effects are (0 for
+/// none): two steps with the same addresses have the same shape.
+fn logic_addresses(s: &StepInfo) -> [usize; 7] {
     fn at<T>(v: &Option<Arc<T>>) -> usize {
         v.as_ref().map_or(0, |a| Arc::as_ptr(a) as usize)
     }
     [
+        Arc::as_ptr(&s.action) as *const u8 as usize,
+        Arc::as_ptr(&s.args) as *const u8 as usize,
         at(&s.pre_start),
         at(&s.pre_over_all),
         at(&s.pre_end),
@@ -670,15 +677,22 @@ fn shape_of(s: &StepInfo, out: &mut String) {
     out.push(')');
 }
 
-fn row_of(s: &StepInfo, shape: usize, out: &mut String) {
-    out.push_str("    (");
-    push_int(out, shape);
-    out.push_str(", (");
-    for a in s.args.iter() {
-        push_py_str(out, a);
+/// `("a", "b", )`: a step's arguments as a Python tuple.
+fn args_tuple(args: &[String]) -> String {
+    let mut out = String::from("(");
+    for a in args {
+        push_py_str(&mut out, a);
         out.push_str(", ");
     }
     out.push(')');
+    out
+}
+
+fn row_of(s: &StepInfo, shape: usize, args: &str, out: &mut String) {
+    out.push_str("    (");
+    push_int(out, shape);
+    out.push_str(", ");
+    out.push_str(args);
     let extra = s.skipped || !s.after.is_empty();
     if s.duration.is_some() || extra {
         out.push_str(", ");

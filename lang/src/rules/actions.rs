@@ -6,18 +6,18 @@
 
 use super::ast::NamePart;
 use super::matching::{count_comparison, match_name, Captures};
-use btc_pddl::ast::Domain;
+use btc_pddl::ast::{Domain, SmolStr};
 use rustc_hash::FxHashMap;
 
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct ActionIndex {
     /// Action name to its indices in `domain.actions`, in domain order
     /// (more than one only when the domain repeats a name).
-    by_name: FxHashMap<String, Vec<usize>>,
+    by_name: FxHashMap<SmolStr, Vec<usize>>,
     /// (name, index), sorted by name.
-    forwards: Vec<(String, usize)>,
+    forwards: Vec<(SmolStr, usize)>,
     /// (name reversed, index), sorted by reversed name.
-    backwards: Vec<(String, usize)>,
+    backwards: Vec<(SmolStr, usize)>,
 }
 
 impl ActionIndex {
@@ -81,7 +81,7 @@ impl ActionIndex {
 }
 
 /// The entries of a sorted list whose names start with `prefix`.
-fn starting_with<'a>(sorted: &'a [(String, usize)], prefix: &str) -> &'a [(String, usize)] {
+fn starting_with<'a>(sorted: &'a [(SmolStr, usize)], prefix: &str) -> &'a [(SmolStr, usize)] {
     let from = sorted.partition_point(|(n, _)| n.as_str() < prefix);
     let len = sorted[from..].partition_point(|(n, _)| n.starts_with(prefix));
     &sorted[from..from + len]

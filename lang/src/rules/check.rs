@@ -1396,10 +1396,10 @@ fn literals(
                 btc_pddl::ast::Term::Var { name } => {
                     position(&name.name).map_or(format!("?{}", name.name), |i| format!("#{i}"))
                 }
-                btc_pddl::ast::Term::Const { name } => name.name.clone(),
+                btc_pddl::ast::Term::Const { name } => name.name.to_string(),
             })
             .collect();
-        out.insert((positive, atom.pred.name.clone(), args));
+        out.insert((positive, atom.pred.name.to_string(), args));
     }
     Some(out)
 }

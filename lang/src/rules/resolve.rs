@@ -239,7 +239,7 @@ impl Walk<'_> {
                         self.push(
                             *span,
                             Target::Action {
-                                name: a.name.name.clone(),
+                                name: a.name.name.to_string(),
                             },
                             false,
                         );
@@ -429,7 +429,7 @@ impl Walk<'_> {
         let depth = self.vars.len();
         for v in vars {
             self.vars
-                .push((v.name.name.clone(), Binding::Local(v.name.span)));
+                .push((v.name.name.to_string(), Binding::Local(v.name.span)));
             self.var(&v.name.name, v.name.span, true);
             self.type_spec(&v.ty);
         }
@@ -451,7 +451,7 @@ impl Walk<'_> {
                 self.push(
                     n.span,
                     Target::Type {
-                        name: n.name.clone(),
+                        name: n.name.to_string(),
                     },
                     false,
                 );
@@ -461,14 +461,14 @@ impl Walk<'_> {
 
     fn atom(&mut self, a: &Atom) {
         let known = self.ctx.is_some_and(|c| {
-            c.index.predicates.contains_key(&a.pred.name)
-                || c.index.functions.contains_key(&a.pred.name)
+            c.index.predicates.contains_key(a.pred.name.as_str())
+                || c.index.functions.contains_key(a.pred.name.as_str())
         });
         if known {
             self.push(
                 a.pred.span,
                 Target::Predicate {
-                    name: a.pred.name.clone(),
+                    name: a.pred.name.to_string(),
                 },
                 false,
             );

@@ -45,7 +45,7 @@ pub fn changes(r: &Rule, a: &Action) -> Vec<String> {
     }
     let term = |t: &Term| -> Option<String> {
         match t {
-            Term::Const { name } => Some(name.name.clone()),
+            Term::Const { name } => Some(name.name.to_string()),
             Term::Var { name } => {
                 let k = a.params.iter().position(|p| p.name.name == name.name)?;
                 Some(canon(&r.pattern.params[slots[k]].var.text, &same))
@@ -54,7 +54,7 @@ pub fn changes(r: &Rule, a: &Action) -> Vec<String> {
     };
     let lit = |atom: &Atom| -> Option<Lit> {
         let args: Option<Vec<String>> = atom.args.iter().map(term).collect();
-        Some((atom.pred.name.clone(), args?))
+        Some((atom.pred.name.to_string(), args?))
     };
     let (mut pre_pos, mut pre_neg) = (BTreeSet::new(), BTreeSet::new());
     for f in a.pre_start.iter().chain(&a.pre_over_all) {

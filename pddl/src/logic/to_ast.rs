@@ -8,7 +8,7 @@ use crate::source::Span;
 
 fn ast_name(n: &str, span: Span) -> ast::Name {
     ast::Name {
-        name: n.to_owned(),
+        name: n.into(),
         span,
     }
 }

@@ -24,9 +24,16 @@ impl NameFit {
         // SipHash's flooding resistance on a name per argument.
         let mut seen = rustc_hash::FxHashSet::default();
         let mut unknown = Vec::new();
-        for arg in plan.steps.iter().flat_map(|s| &s.args) {
-            if seen.insert(arg.name.as_str()) && !pix.objects.contains_key(&arg.name) {
-                unknown.push(arg.clone());
+        // A call seen before has no name not seen before.
+        let mut calls = rustc_hash::FxHashSet::default();
+        for step in &plan.steps {
+            if !calls.insert(std::sync::Arc::as_ptr(&step.call)) {
+                continue;
+            }
+            for (k, name) in step.call.args.iter().enumerate() {
+                if seen.insert(name.as_str()) && !pix.objects.contains_key(name.as_str()) {
+                    unknown.push(step.args().nth(k).expect("the call's argument"));
+                }
             }
         }
         NameFit {

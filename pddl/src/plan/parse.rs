@@ -6,10 +6,12 @@
 //! line's shape decides its format, and reading must run at millions of steps
 //! per second.
 
-use crate::ast::Name;
+pub use super::step::{Call, PlanStep};
+use crate::ast::{Name, SmolStr};
 use crate::diagnostic::{codes, Diagnostic};
 use crate::source::{FileId, Span};
 use serde::Serialize;
+use smol_str::StrExt;
 
 mod quick;
 
@@ -26,18 +28,6 @@ pub enum PlanFormat {
     Ff,
     /// No steps at all.
     Empty,
-}
-
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct PlanStep {
-    pub action: Name,
-    pub args: Vec<Name>,
-    pub time: Option<f64>,
-    pub duration: Option<f64>,
-    /// 1-based line number in the plan file.
-    pub line: u32,
-    /// The step as written, from its action name (or `(`) to its end.
-    pub span: Span,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -73,6 +63,7 @@ fn read_plan(text: &str, file: FileId, quick: bool) -> (Plan, Vec<Diagnostic>) {
     };
     let mut diags = Vec::new();
     let mut in_ff = false;
+    let mut calls = quick::Calls::default();
     for (i, (line_start, raw)) in lines_of(text).enumerate() {
         let line = raw.strip_suffix('\r').unwrap_or(raw);
         let place = quick::Place {
@@ -80,7 +71,10 @@ fn read_plan(text: &str, file: FileId, quick: bool) -> (Plan, Vec<Diagnostic>) {
             file,
             line: i as u32 + 1,
         };
-        let read = match quick.then(|| quick::step(line, place)).flatten() {
+        let read = match quick
+            .then(|| quick::step(line, place, &mut calls))
+            .flatten()
+        {
             Some(l) => Ok(l),
             None => LineReader::new(line, place).read(&mut in_ff),
         };
@@ -146,11 +140,11 @@ struct LineReader<'a> {
     line: u32,
 }
 
-fn lower(s: &str) -> String {
+fn lower(s: &str) -> SmolStr {
     if s.is_ascii() {
-        s.to_ascii_lowercase()
+        s.to_ascii_lowercase_smolstr()
     } else {
-        s.to_lowercase()
+        s.to_lowercase_smolstr()
     }
 }
 
@@ -321,14 +315,8 @@ impl<'a> LineReader<'a> {
             return Err(self.error(start, self.text.len(), "expected an action name"));
         }
         let action = words.remove(0);
-        Ok(PlanStep {
-            span: action.span.to(words.last().map_or(action.span, |w| w.span)),
-            action,
-            args: words,
-            time: None,
-            duration: None,
-            line: self.line,
-        })
+        let span = action.span.to(words.last().map_or(action.span, |w| w.span));
+        Ok(PlanStep::new(action, words, None, None, self.line, span))
     }
 
     /// `(name arg ...)` then, optionally, `[duration]` and a `;` comment.
@@ -378,14 +366,10 @@ impl<'a> LineReader<'a> {
             }
         }
         let action = words.remove(0);
-        Ok(PlanStep {
-            action,
-            args: words,
-            time,
-            duration,
-            line: self.line,
-            span: self.span(open, close + 1),
-        })
+        let span = self.span(open, close + 1);
+        Ok(PlanStep::new(
+            action, words, time, duration, self.line, span,
+        ))
     }
 
     /// `[1.000]` or LPG's `[D:1.00; C:4099.73]`.
@@ -438,8 +422,8 @@ mod tests {
             .steps
             .iter()
             .map(|s| {
-                let mut out = s.action.name.clone();
-                for a in &s.args {
+                let mut out = s.action_name().to_string();
+                for a in s.args() {
                     out.push(' ');
                     out.push_str(&a.name);
                 }
@@ -458,7 +442,7 @@ mod tests {
         assert!(diags.is_empty());
         assert_eq!(plan.format, PlanFormat::SasPlan);
         assert_eq!(plan.steps.len(), 2);
-        assert!(plan.steps[1].args.is_empty());
+        assert_eq!(plan.steps[1].arg_count(), 0);
         assert_eq!(plan.stated_cost.as_ref().unwrap().value, 4.0);
         assert_eq!(plan.steps[0].span, Span::new(0, 0, 23));
     }
@@ -484,7 +468,7 @@ mod tests {
         let (plan, diags) = parse_plan(text, 0);
         assert!(diags.is_empty(), "{diags:?}");
         assert_eq!(plan.format, PlanFormat::Timed);
-        let names: Vec<_> = plan.steps.iter().map(|s| s.action.name.as_str()).collect();
+        let names: Vec<_> = plan.steps.iter().map(|s| s.action_name()).collect();
         assert_eq!(names, vec!["load", "board", "walk", "navigate"]);
         assert_eq!(plan.steps[2].duration, Some(1.0));
         assert_eq!(plan.steps[3].line, 6);
@@ -651,7 +635,10 @@ mod tests {
             "2.001: (PICK_OP1 robot1 screwdriver tool_rack) [3.000]",
             "0:\t(load r h c1)\t[2]",
         ] {
-            assert!(quick::step(line, at).is_some(), "{line}");
+            assert!(
+                quick::step(line, at, &mut quick::Calls::default()).is_some(),
+                "{line}"
+            );
         }
     }
 

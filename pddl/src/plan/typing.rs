@@ -2,11 +2,14 @@
 //! of the domain) and checks it against the action's parameter types, as the
 //! NIST executor does with the problem's `:objects`.
 
-use super::parse::{Plan, PlanStep};
+use super::parse::Plan;
+use super::step::{Call, PlanStep};
 use crate::ast::Domain;
 use crate::check::{DomainIndex, ProblemIndex};
 use crate::diagnostic::{codes, did_you_mean, Diagnostic};
+use rustc_hash::FxHashMap;
 use serde::Serialize;
+use std::sync::Arc;
 
 /// A plan step with its action and arguments resolved to ids.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]
@@ -15,8 +18,9 @@ pub struct GroundStep {
     pub step: usize,
     /// Index into `domain.actions`.
     pub action: usize,
-    /// Object ids (see [`ProblemIndex::object_names`]).
-    pub args: Vec<u32>,
+    /// Object ids (see [`ProblemIndex::object_names`]); shared by the
+    /// steps that make the same call.
+    pub args: Arc<[u32]>,
 }
 
 /// Types every step; steps with an error are left out of the result and
@@ -29,8 +33,18 @@ pub fn type_plan(
 ) -> (Vec<GroundStep>, Vec<Diagnostic>) {
     let mut out = Vec::with_capacity(plan.steps.len());
     let mut diags = Vec::new();
+    // A call that typed once types again the same way; a call with an
+    // error is typed at each step, which reports it there.
+    let mut typed: FxHashMap<*const Call, (usize, Arc<[u32]>)> = FxHashMap::default();
     for (i, step) in plan.steps.iter().enumerate() {
-        if let Some(g) = type_step(i, step, domain, dix, pix, &mut diags) {
+        if let Some((action, args)) = typed.get(&Arc::as_ptr(&step.call)) {
+            out.push(GroundStep {
+                step: i,
+                action: *action,
+                args: args.clone(),
+            });
+        } else if let Some(g) = type_step(i, step, domain, dix, pix, &mut diags) {
+            typed.insert(Arc::as_ptr(&step.call), (g.action, g.args.clone()));
             out.push(g);
         }
     }
@@ -45,18 +59,15 @@ fn type_step(
     pix: &ProblemIndex,
     diags: &mut Vec<Diagnostic>,
 ) -> Option<GroundStep> {
-    let Some(sig) = dix.actions.get(step.action.as_str()) else {
+    let Some(sig) = dix.actions.get(step.action_name()) else {
+        let name = step.action();
         let d = Diagnostic::error(
             codes::PLAN_UNKNOWN_ACTION,
-            step.action.span,
-            format!(
-                "step {}: the domain has no action `{}`",
-                i + 1,
-                step.action.name
-            ),
+            name.span,
+            format!("step {}: the domain has no action `{}`", i + 1, name.name),
         );
         diags.push(
-            match did_you_mean(&step.action.name, dix.actions.keys().map(String::as_str)) {
+            match did_you_mean(&name.name, dix.actions.keys().map(String::as_str)) {
                 Some(h) => d.with_hint(h),
                 None => d.with_hint("is this plan for another domain?"),
             },
@@ -64,7 +75,7 @@ fn type_step(
         return None;
     };
     let action = &domain.actions[sig.index];
-    if step.args.len() != sig.params.len() {
+    if step.arg_count() != sig.params.len() {
         let params: Vec<String> = action
             .params
             .iter()
@@ -77,23 +88,23 @@ fn type_step(
                 format!(
                     "step {}: `{}` takes {} argument{}, but the plan gives {}",
                     i + 1,
-                    step.action.name,
+                    step.action_name(),
                     sig.params.len(),
                     if sig.params.len() == 1 { "" } else { "s" },
-                    step.args.len()
+                    step.arg_count()
                 ),
             )
             .with_label(
                 action.name.span,
-                format!("`{}` is declared here", step.action.name),
+                format!("`{}` is declared here", step.action_name()),
             )
             .with_hint(format!("its parameters are ({})", params.join(" "))),
         );
         return None;
     }
-    let mut args = Vec::with_capacity(step.args.len());
+    let mut args = Vec::with_capacity(step.arg_count());
     let mut ok = true;
-    for (k, (arg, want)) in step.args.iter().zip(&sig.params).enumerate() {
+    for (k, (arg, want)) in step.args().zip(&sig.params).enumerate() {
         let Some(obj) = pix.objects.get(arg.as_str()) else {
             let d = Diagnostic::error(
                 codes::PLAN_UNKNOWN_OBJECT,
@@ -125,7 +136,7 @@ fn type_step(
                         arg.name,
                         dix.types.display(&obj.types),
                         p.name.name,
-                        step.action.name,
+                        step.action_name(),
                         dix.types.display(want)
                     ),
                 )
@@ -140,6 +151,6 @@ fn type_step(
     ok.then_some(GroundStep {
         step: i,
         action: sig.index,
-        args,
+        args: args.into(),
     })
 }

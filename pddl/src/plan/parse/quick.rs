@@ -5,9 +5,17 @@
 //! reports problems; so on the lines it accepts it must read exactly what
 //! the careful reader reads (a test in `super::tests` compares them).
 
-use super::{Line, PlanFormat, PlanStep};
-use crate::ast::Name;
+use super::{Call, Line, PlanFormat, PlanStep};
+use crate::ast::{Name, SmolStr};
 use crate::source::{FileId, Span};
+use rustc_hash::FxHashMap;
+use smol_str::StrExt;
+use std::sync::Arc;
+
+/// The calls read so far, by their text from `(` to `)`: a call written
+/// again (byte for byte) is the same call at another place, so it is
+/// neither read nor stored again.
+pub(super) type Calls<'a> = FxHashMap<&'a str, Arc<Call>>;
 
 /// Where a line is: what spans and steps need of it.
 #[derive(Clone, Copy)]
@@ -24,7 +32,7 @@ impl Place {
 }
 
 /// The step on `text`, or `None` for the careful reader to decide.
-pub(super) fn step(text: &str, at: Place) -> Option<Line> {
+pub(super) fn step<'a>(text: &'a str, at: Place, calls: &mut Calls<'a>) -> Option<Line> {
     let b = text.as_bytes();
     let mut pos = skip_ws(b, 0);
     let time = if b.get(pos)?.is_ascii_digit() {
@@ -41,8 +49,19 @@ pub(super) fn step(text: &str, at: Place) -> Option<Line> {
         return None;
     }
     let open = pos;
-    let (action, after) = name(text, open + 1, at)?;
-    let (args, close) = args(text, after, at)?;
+    let close = open + memchr::memchr(b')', &b[open..])?;
+    let call = match calls.get(&text[open..=close]) {
+        Some(call) => call.clone(),
+        None => {
+            let (action, after) = name(text, open + 1, at)?;
+            let (args, end) = args(text, after, at)?;
+            // Names stop at spaces and `)`: the first `)` ends them.
+            debug_assert_eq!(end, close);
+            let call = Arc::new(Call::new(action, args, at.span(open, close + 1)));
+            calls.insert(&text[open..=close], call.clone());
+            call
+        }
+    };
     let (duration, end) = duration(b, skip_ws(b, close + 1))?;
     // Only a comment may follow.
     if end < b.len() && b[end] != b';' {
@@ -55,8 +74,7 @@ pub(super) fn step(text: &str, at: Place) -> Option<Line> {
     Some(Line::Step(
         format,
         PlanStep {
-            action,
-            args,
+            call,
             time,
             duration,
             line: at.line,
@@ -114,11 +132,13 @@ fn name(text: &str, pos: usize, at: Place) -> Option<(Name, usize)> {
     if end == start || !(next == b')' || CLASS[next as usize] == SPACE) {
         return None;
     }
-    let mut name = text[start..end].to_owned();
+    let written = &text[start..end];
     // Most arguments are written in lower case already.
-    if seen & UPPER != 0 {
-        name.make_ascii_lowercase();
-    }
+    let name = if seen & UPPER != 0 {
+        written.to_ascii_lowercase_smolstr()
+    } else {
+        SmolStr::new(written)
+    };
     let name = Name {
         name,
         span: at.span(start, end),
