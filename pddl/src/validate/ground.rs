@@ -14,6 +14,7 @@
 use super::tracked::{Literal, TrackedFacts};
 use crate::state::{CTerm, CompiledAction, Cond, Eff, State};
 use rustc_hash::FxHashMap;
+use std::marker::PhantomData;
 
 /// A phase's conditions.
 pub(super) enum GroundConds {
@@ -43,32 +44,58 @@ pub(super) struct GroundAction {
     pub eff_end: GroundEffects,
 }
 
-/// The ground actions of one replay, and the atoms they mention.
+/// The ground actions of one replay, and the atoms they mention; `'s` is
+/// the life of the steps' argument lists.
 #[derive(Default)]
-pub(super) struct GroundActions {
+pub(super) struct GroundActions<'s> {
     /// `[action index, args...]` to an index of `actions`.
     index: FxHashMap<Box<[u32]>, usize>,
+    /// The same by the address and length of an argument list: plan steps
+    /// that make the same call share theirs, and looking up an address
+    /// hashes three words. An address stands for the arguments it holds
+    /// because the lists outlive this table (`'s`).
+    by_address: FxHashMap<(usize, *const u32, usize), usize>,
+    lists: PhantomData<&'s [u32]>,
     actions: Vec<GroundAction>,
     /// Room for the key of the step being looked up.
     key: Vec<u32>,
     pub facts: TrackedFacts,
 }
 
-impl GroundActions {
+impl<'s> GroundActions<'s> {
     /// The ground action `action` of the domain with `args`, grounded on
     /// first use; `state` gives the truth of atoms first seen.
     pub fn get(
         &mut self,
         action: usize,
         compiled: &CompiledAction,
-        args: &[u32],
+        args: &'s [u32],
         state: &State,
     ) -> (&GroundAction, &mut TrackedFacts) {
+        let address = (action, args.as_ptr(), args.len());
+        let i = match self.by_address.get(&address) {
+            Some(&i) => i,
+            None => {
+                let i = self.by_content(action, compiled, args, state);
+                self.by_address.insert(address, i);
+                i
+            }
+        };
+        (&self.actions[i], &mut self.facts)
+    }
+
+    fn by_content(
+        &mut self,
+        action: usize,
+        compiled: &CompiledAction,
+        args: &[u32],
+        state: &State,
+    ) -> usize {
         self.key.clear();
         self.key
             .push(u32::try_from(action).expect("fewer than 2^32 actions"));
         self.key.extend_from_slice(args);
-        let i = match self.index.get(&self.key[..]) {
+        match self.index.get(&self.key[..]) {
             Some(&i) => i,
             None => {
                 let g = ground(compiled, args, &mut self.facts, state);
@@ -77,8 +104,7 @@ impl GroundActions {
                 self.index.insert(self.key.as_slice().into(), i);
                 i
             }
-        };
-        (&self.actions[i], &mut self.facts)
+        }
     }
 }
 

@@ -146,7 +146,7 @@ fn missing_goals(world: &World, state: &State, goal: &Formula, cond: &Cond) -> V
 
 pub fn show_step(world: &World, action: &Action, g: &GroundStep) -> String {
     let mut s = format!("({}", action.name.name);
-    for &o in &g.args {
+    for &o in g.args.iter() {
         s.push(' ');
         s.push_str(world.object_name(o));
     }

@@ -18,7 +18,7 @@ pub(super) struct Stepper<'a> {
     world: &'a World,
     actions: Actions<'a>,
     /// `None`: every step takes the general path.
-    ground: Option<GroundActions>,
+    ground: Option<GroundActions<'a>>,
     binding: Vec<u32>,
     /// Kept from step to step so that a long replay does not allocate it
     /// again for each.
@@ -45,7 +45,7 @@ impl<'a> Stepper<'a> {
         &mut self,
         state: &mut State,
         plan: &Plan,
-        g: &GroundStep,
+        g: &'a GroundStep,
     ) -> Result<(), Diagnostic> {
         let world = self.world;
         let action = self.actions.get(g.action)?;
