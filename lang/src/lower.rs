@@ -597,11 +597,22 @@ fn rule_id(r: &Rule, taken: &BTreeSet<String>) -> String {
 /// How a ground action lowers: the rule tree it calls (`None`: skipped),
 /// its effects (a rule's `effect` replaces the action's) and the step's
 /// node below its `Step` boundary.
+#[derive(Clone)]
 struct Lowered {
     rule: Option<Arc<str>>,
     eff_start: Option<Arc<logic::Effect>>,
     eff_end: Option<Arc<logic::Effect>>,
     child: Option<Arc<Node>>,
+}
+
+/// What the steps of one call (the same action and the same shared
+/// argument list, as typing gives the steps that write the same call) have
+/// in common: found at the call's first step, then looked up once a step.
+struct CallParts {
+    action: Arc<str>,
+    args: Arc<[String]>,
+    ground: action::Ground,
+    lowered: Option<Lowered>,
 }
 
 /// Lowers a plan; every problem is reported at the plan line of its step.
@@ -621,6 +632,8 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
     // action its name.
     let mut action_names: rustc_hash::FxHashMap<usize, Arc<str>> = Default::default();
     let mut arg_names: rustc_hash::FxHashMap<&[u32], Arc<[String]>> = Default::default();
+    // The same, by call: one lookup a step instead of one a table.
+    let mut calls: rustc_hash::FxHashMap<(usize, *const u32), CallParts> = Default::default();
     let mut rule_effects: BTreeMap<usize, RuleEffect> = BTreeMap::new();
     let mut rule_trees: Vec<(usize, RuleTree)> = Vec::new(); // by rule index
     let mut taken = BTreeSet::new();
@@ -641,11 +654,8 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
     for (k, g) in input.steps.iter().enumerate() {
         let step = &input.plan.steps[g.step];
         let action = &input.domain.actions[g.action];
-        let ground = grounder.ground(input.domain, g.action, &g.args, &object_names);
-        let repeated = lowered.get(&(g.action, &g.args[..]));
-        let mut info = StepInfo {
-            index: k,
-            line: step.line,
+        let call = (g.action, Arc::as_ptr(&g.args) as *const u32);
+        let parts = calls.entry(call).or_insert_with(|| CallParts {
             action: action_names
                 .entry(g.action)
                 .or_insert_with(|| action.name.name.as_str().into())
@@ -659,6 +669,16 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
                         .collect()
                 })
                 .clone(),
+            ground: grounder.ground(input.domain, g.action, &g.args, &object_names),
+            lowered: lowered.get(&(g.action, &g.args[..])).cloned(),
+        });
+        let repeated = parts.lowered.clone();
+        let ground = parts.ground.clone();
+        let mut info = StepInfo {
+            index: k,
+            line: step.line,
+            action: parts.action.clone(),
+            args: parts.args.clone(),
             time: step.time,
             duration: step.duration,
             rule: None,
@@ -671,14 +691,11 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
             after: Vec::new(),
         };
         if let Some(r) = repeated {
-            info.rule = r.rule.clone();
-            info.skipped = r.rule.is_none();
-            info.eff_start = r.eff_start.clone();
-            info.eff_end = r.eff_end.clone();
-            step_nodes.push(r.child.as_ref().map(|c| Node::Step {
-                step: k,
-                child: c.clone(),
-            }));
+            info.rule = r.rule;
+            info.skipped = info.rule.is_none();
+            info.eff_start = r.eff_start;
+            info.eff_end = r.eff_end;
+            step_nodes.push(r.child.map(|child| Node::Step { step: k, child }));
             infos.push(info);
             continue;
         }
@@ -729,15 +746,14 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
         };
         let RuleBody::Template { body, effect } = &rule.body else {
             info.skipped = true;
-            lowered.insert(
-                (g.action, &g.args[..]),
-                Lowered {
-                    rule: None,
-                    eff_start: info.eff_start.clone(),
-                    eff_end: info.eff_end.clone(),
-                    child: None,
-                },
-            );
+            let done = Lowered {
+                rule: None,
+                eff_start: info.eff_start.clone(),
+                eff_end: info.eff_end.clone(),
+                child: None,
+            };
+            calls.get_mut(&call).expect("entered above").lowered = Some(done.clone());
+            lowered.insert((g.action, &g.args[..]), done);
             infos.push(info);
             step_nodes.push(None);
             continue;
@@ -892,15 +908,14 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
         let child = Arc::new(child);
         // A step with a diagnostic is not reused: each step reports its own.
         if diags.len() == diags_before {
-            lowered.insert(
-                (g.action, &g.args[..]),
-                Lowered {
-                    rule: info.rule.clone(),
-                    eff_start: info.eff_start.clone(),
-                    eff_end: info.eff_end.clone(),
-                    child: Some(Arc::clone(&child)),
-                },
-            );
+            let done = Lowered {
+                rule: info.rule.clone(),
+                eff_start: info.eff_start.clone(),
+                eff_end: info.eff_end.clone(),
+                child: Some(Arc::clone(&child)),
+            };
+            calls.get_mut(&call).expect("entered above").lowered = Some(done.clone());
+            lowered.insert((g.action, &g.args[..]), done);
         }
         step_nodes.push(Some(Node::Step { step: k, child }));
         infos.push(info);

@@ -60,12 +60,11 @@ const SCRIPT_ATTRIBUTE: Unsupported = Unsupported {
 /// (none when it can express all of it).
 pub fn refusals(db: &dyn Db, job: CompileJob, ir: &TreeIr, target: Target) -> Vec<Diagnostic> {
     let Target::Pytrees = target;
-    let used: Vec<&Unsupported> = NOT_IN_PYTREES
-        .iter()
-        .filter(|u| uses_leaf(ir, u.id))
-        .collect();
-    let scripted = uses_scripts(ir);
-    let nodes = nodes_not_in_pytrees(ir);
+    let TreeUses {
+        leaves: used,
+        scripted,
+        decorators: nodes,
+    } = tree_uses(ir);
     if used.is_empty() && nodes.is_empty() && !scripted {
         return Vec::new();
     }
@@ -124,44 +123,59 @@ pub fn refusals(db: &dyn Db, job: CompileJob, ir: &TreeIr, target: Target) -> Ve
     out
 }
 
-/// Whether a node of the compiled tree has pre- or post-condition scripts.
-fn uses_scripts(ir: &TreeIr) -> bool {
-    let mut found = false;
+/// What the compiled tree (the main tree and the rules') uses that py_trees
+/// lacks.
+struct TreeUses {
+    /// The leaves of [`NOT_IN_PYTREES`] it uses.
+    leaves: Vec<&'static Unsupported>,
+    /// Whether a node has pre- or post-condition scripts.
+    scripted: bool,
+    /// The decorators the vocabulary marks as not expressible in py_trees.
+    decorators: Vec<DecoratorName>,
+}
+
+/// [`TreeUses`], in one walk: a long plan's main tree has a node a step.
+fn tree_uses(ir: &TreeIr) -> TreeUses {
+    let mut uses = TreeUses {
+        leaves: Vec::new(),
+        scripted: false,
+        decorators: Vec::new(),
+    };
     let mut look = |n: &Node| {
-        found |= match n {
+        uses.scripted |= match n {
             Node::Control { scripts, .. }
             | Node::Decorator { scripts, .. }
             | Node::Leaf { scripts, .. }
             | Node::SubTree { scripts, .. } => !scripts.is_empty(),
             Node::Step { .. } => false,
         };
-    };
-    ir.root.walk_distinct(&mut look);
-    for t in &ir.trees {
-        t.root.walk(&mut look);
-    }
-    found
-}
-
-/// The decorators in the compiled tree that the vocabulary marks as not
-/// expressible in py_trees.
-fn nodes_not_in_pytrees(ir: &TreeIr) -> Vec<DecoratorName> {
-    let mut found = Vec::new();
-    let mut look = |n: &Node| {
-        if let Node::Decorator { decorator, .. } = n {
-            let name = decorator.name();
-            if matches!(name.spec().pytrees, PyTrees::NotExpressible { .. })
-                && !found.contains(&name)
-            {
-                found.push(name);
+        match n {
+            Node::Leaf { id, .. } => {
+                for u in NOT_IN_PYTREES.iter().filter(|u| u.id == id) {
+                    if !uses.leaves.iter().any(|l| l.id == u.id) {
+                        uses.leaves.push(u);
+                    }
+                }
             }
+            Node::Decorator { decorator, .. } => {
+                let name = decorator.name();
+                if matches!(name.spec().pytrees, PyTrees::NotExpressible { .. })
+                    && !uses.decorators.contains(&name)
+                {
+                    uses.decorators.push(name);
+                }
+            }
+            _ => {}
         }
     };
     ir.root.walk_distinct(&mut look);
     for t in &ir.trees {
         t.root.walk(&mut look);
     }
-    found
+    // In the order of NOT_IN_PYTREES, as the hints are looked up.
+    uses.leaves
+        .sort_by_key(|u| NOT_IN_PYTREES.iter().position(|n| n.id == u.id));
+    uses
 }
 
 /// Every decorator in a template, with the span of its keyword.
@@ -191,21 +205,6 @@ fn decorators_in(t: &Template, out: &mut Vec<(DecoratorName, Span)>) {
         | Template::Steps { .. }
         | Template::Error { .. } => {}
     }
-}
-
-/// Whether a leaf `id` is in the compiled tree (the main tree or a rule's).
-fn uses_leaf(ir: &TreeIr, id: &str) -> bool {
-    let mut found = false;
-    let mut look = |n: &Node| {
-        if let Node::Leaf { id: leaf, .. } = n {
-            found |= leaf == id;
-        }
-    };
-    ir.root.walk_distinct(&mut look);
-    for t in &ir.trees {
-        t.root.walk(&mut look);
-    }
-    found
 }
 
 /// The templates of an item: a rule's body, a tree's, the plan's.
