@@ -164,20 +164,41 @@ impl Node {
     /// passes that collect what a tree uses: a long plan's steps share few
     /// children.
     pub fn walk_distinct<'a>(&'a self, f: &mut impl FnMut(&'a Node)) {
-        fn go<'a>(n: &'a Node, f: &mut impl FnMut(&'a Node), seen: &mut FxHashSet<*const Node>) {
+        /// The shared children seen: a set, and in front of it a small
+        /// table of recent ones (a step's child is nearly always one a
+        /// recent step had), which answers most steps without hashing.
+        struct Seen {
+            recent: [*const Node; 64],
+            all: FxHashSet<*const Node>,
+        }
+        impl Seen {
+            fn first_time(&mut self, p: *const Node) -> bool {
+                let slot = &mut self.recent[(p as usize >> 4) % 64];
+                if *slot == p {
+                    return false;
+                }
+                *slot = p;
+                self.all.insert(p)
+            }
+        }
+        fn go<'a>(n: &'a Node, f: &mut impl FnMut(&'a Node), seen: &mut Seen) {
             f(n);
             match n {
                 Node::Control { children, .. } => children.iter().for_each(|c| go(c, f, seen)),
                 Node::Decorator { child, .. } => go(child, f, seen),
                 Node::Step { child, .. } => {
-                    if seen.insert(Arc::as_ptr(child)) {
+                    if seen.first_time(Arc::as_ptr(child)) {
                         go(child, f, seen)
                     }
                 }
                 Node::Leaf { .. } | Node::SubTree { .. } => {}
             }
         }
-        go(self, f, &mut FxHashSet::default())
+        let mut seen = Seen {
+            recent: [std::ptr::null(); 64],
+            all: FxHashSet::default(),
+        };
+        go(self, f, &mut seen)
     }
 
     /// Calls `f` on this node and every node below it (not into subtrees).
@@ -530,5 +551,66 @@ mod float_tests {
         }
         assert_eq!(format_float(-0.0), "-0.0");
         assert_eq!(format_float(3.0), "3.0");
+    }
+}
+
+#[cfg(test)]
+mod walk_tests {
+    use super::*;
+
+    fn leaf(id: &str) -> Node {
+        Node::Leaf {
+            leaf: LeafKind::Action,
+            id: id.to_owned(),
+            name: None,
+            ports: Vec::new(),
+            scripts: NodeScripts::default(),
+        }
+    }
+
+    /// Every step is visited, and each shared child (and what is below it)
+    /// once, however the steps interleave their children: many children,
+    /// so that some share a slot of the table of recent ones.
+    #[test]
+    fn walk_distinct_visits_each_shared_child_once() {
+        let children: Vec<Arc<Node>> = (0..300)
+            .map(|i| Arc::new(Node::sequence(vec![leaf(&format!("a{i}")), leaf("b")])))
+            .collect();
+        let mut order = Vec::new();
+        let mut x = 7u64;
+        for k in 0..5000 {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let i = if k % 3 == 0 {
+                k % 300
+            } else {
+                (x >> 33) as usize % 300
+            };
+            order.push(i);
+        }
+        let root = Node::sequence(
+            order
+                .iter()
+                .enumerate()
+                .map(|(step, &i)| Node::Step {
+                    step,
+                    child: children[i].clone(),
+                })
+                .collect(),
+        );
+        let (mut steps, mut leaves) = (0, std::collections::HashMap::<String, usize>::new());
+        root.walk_distinct(&mut |n| match n {
+            Node::Step { .. } => steps += 1,
+            Node::Leaf { id, .. } => *leaves.entry(id.clone()).or_default() += 1,
+            _ => {}
+        });
+        assert_eq!(steps, order.len());
+        let used: std::collections::BTreeSet<_> = order.iter().collect();
+        for i in 0..300 {
+            let want = usize::from(used.contains(&i));
+            assert_eq!(leaves.get(&format!("a{i}")).copied().unwrap_or(0), want);
+        }
+        assert_eq!(leaves["b"], used.len());
     }
 }
