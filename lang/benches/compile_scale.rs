@@ -7,9 +7,8 @@
 //! `benches/peers/p3_seed_generator.py`, the P3 seed's algorithm written
 //! anew in Python, timed as a whole process on the same plan. Printed per
 //! format: median time of 11 (the peer's of 5) and the speed-up over the
-//! peer, peak heap during
-//! the compile next to the output's size, bytes per step next to the
-//! peer's; each with its target.
+//! peer, peak heap during the compile next to the output's size, bytes per
+//! step next to the peer's; each with its target.
 
 use btc_emit::{emit, pytrees::Runtime, Format, Options};
 use btc_lang::db::{compile, CompileJob, Database};
