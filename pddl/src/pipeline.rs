@@ -6,7 +6,7 @@ use crate::diagnostic::{has_errors, Diagnostic};
 use crate::plan::{self, GroundStep, Plan};
 use crate::source::{FileId, Sources};
 use crate::state::World;
-use crate::validate::{validate, Validation};
+use crate::validate::{validate, Replay, Validation};
 use crate::{ast::Domain, ast::Problem, DomainIndex, ProblemIndex};
 
 pub struct DomainUnit {
@@ -121,5 +121,12 @@ pub fn validate_units(
     let (d, p) = (domain.domain.as_ref()?, problem.problem.as_ref()?);
     // A checked, error-free domain and problem always make a world.
     let world = World::of_checked(d, &domain.index, p, &problem.index).ok()?;
-    Some(validate(&world, d, p, &plan.plan, &plan.steps))
+    Some(validate(
+        Replay::Cached,
+        &world,
+        d,
+        p,
+        &plan.plan,
+        &plan.steps,
+    ))
 }

@@ -8,62 +8,13 @@ use btc_pddl::pipeline::{
 };
 use btc_pddl::render::to_short;
 use btc_pddl::source::Sources;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-/// One problem with its domain and plans.
-struct Case {
-    dir: PathBuf,
-    domain: PathBuf,
-    problem: PathBuf,
-    plans: Vec<PathBuf>,
-}
+use btc_testkit::CorpusCase as Case;
 
 /// Every corpus case; `None` (the test skipped) without the corpus.
 fn cases() -> Option<Vec<Case>> {
-    let corpus_dir = btc_testkit::corpus()?;
-    let mut out = Vec::new();
-    let mut dirs: Vec<PathBuf> = std::fs::read_dir(&corpus_dir)
-        .expect("corpus directory (set BTC_CORPUS to override)")
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.is_dir())
-        .collect();
-    dirs.sort();
-    for dir in dirs {
-        let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
-            .unwrap()
-            .map(|e| e.unwrap().path())
-            .collect();
-        files.sort();
-        let name = |p: &Path| p.file_name().unwrap().to_string_lossy().into_owned();
-        for problem in files
-            .iter()
-            .filter(|p| name(p).ends_with(".pddl") && !name(p).contains("domain"))
-        {
-            let stem = problem.file_stem().unwrap().to_string_lossy().into_owned();
-            // `domain.pddl`, or `pNN-domain.pddl` beside `pNN.pddl`
-            let own = dir.join(format!("{stem}-domain.pddl"));
-            let domain = if own.exists() {
-                own
-            } else {
-                dir.join("domain.pddl")
-            };
-            let plans = files
-                .iter()
-                .filter(|p| {
-                    let n = name(p);
-                    n.starts_with(&format!("{stem}."))
-                        && (n.ends_with(".plan") || n.ends_with(".tplan"))
-                })
-                .cloned()
-                .collect();
-            out.push(Case {
-                dir: dir.clone(),
-                domain,
-                problem: problem.clone(),
-                plans,
-            });
-        }
-    }
+    let out = btc_testkit::corpus_cases()?;
     assert!(
         out.len() >= 40,
         "expected the 40 corpus problems, found {}",

@@ -8,7 +8,7 @@ use btc_pddl::diagnostic::has_errors;
 use btc_pddl::pipeline::{domain_unit, plan_unit, problem_unit, DomainUnit, ProblemUnit};
 use btc_pddl::source::Sources;
 use btc_pddl::state::World;
-use btc_pddl::validate::{validate_by, Replay, Validation};
+use btc_pddl::validate::{validate, Replay, Validation};
 use std::path::{Path, PathBuf};
 
 /// A domain and problem, checked, with the world they make.
@@ -57,7 +57,7 @@ impl Setting {
             plan.diagnostics
         );
         let by = |replay| {
-            validate_by(
+            validate(
                 replay,
                 &self.world,
                 self.domain.domain.as_ref().unwrap(),
@@ -248,12 +248,15 @@ fn the_valid_fixture_costs_what_its_numeric_effects_add_up_to() {
 fn the_examples_plans_and_their_mutants_replay_alike() {
     let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples");
     let mut replayed = 0;
-    for dir in sorted_entries(&examples).into_iter().filter(|d| d.is_dir()) {
+    for dir in btc_testkit::sorted_entries(&examples)
+        .into_iter()
+        .filter(|d| d.is_dir())
+    {
         let (domain, problem) = (dir.join("domain.pddl"), dir.join("problem.pddl"));
         if !domain.exists() || !problem.exists() {
             continue;
         }
-        let plans: Vec<PathBuf> = sorted_entries(&dir)
+        let plans: Vec<PathBuf> = btc_testkit::sorted_entries(&dir)
             .into_iter()
             .filter(|p| file_name(p).starts_with("plan."))
             .collect();
@@ -267,43 +270,17 @@ fn the_examples_plans_and_their_mutants_replay_alike() {
 
 #[test]
 fn the_corpus_plans_and_their_mutants_replay_alike() {
-    let Some(corpus) = btc_testkit::corpus() else {
+    let Some(cases) = btc_testkit::corpus_cases() else {
         return;
     };
     let mut replayed = 0;
-    for dir in sorted_entries(&corpus).into_iter().filter(|d| d.is_dir()) {
-        let files = sorted_entries(&dir);
-        for problem in files.iter().filter(|p| {
-            let n = file_name(p);
-            n.ends_with(".pddl") && !n.contains("domain")
-        }) {
-            let stem = problem.file_stem().unwrap().to_string_lossy().into_owned();
-            let own = dir.join(format!("{stem}-domain.pddl"));
-            let domain = if own.exists() {
-                own
-            } else {
-                dir.join("domain.pddl")
-            };
-            let mut s = Setting::load(&domain, problem);
-            for plan in files.iter().filter(|p| {
-                let n = file_name(p);
-                n.starts_with(&format!("{stem}."))
-                    && (n.ends_with(".plan") || n.ends_with(".tplan"))
-            }) {
-                replayed += s.replay_with_mutants(&plan.display().to_string(), &read(plan));
-            }
+    for case in cases {
+        let mut s = Setting::load(&case.domain, &case.problem);
+        for plan in &case.plans {
+            replayed += s.replay_with_mutants(&plan.display().to_string(), &read(plan));
         }
     }
     assert!(replayed > 1000, "only {replayed} corpus plans replayed");
-}
-
-fn sorted_entries(dir: &Path) -> Vec<PathBuf> {
-    let mut out: Vec<PathBuf> = std::fs::read_dir(dir)
-        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
-        .map(|e| e.unwrap().path())
-        .collect();
-    out.sort();
-    out
 }
 
 fn file_name(p: &Path) -> String {

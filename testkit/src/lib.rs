@@ -51,6 +51,63 @@ pub fn skip(what: &str, how: &str) {
     }
 }
 
+/// The entries of `dir`, in path order.
+pub fn sorted_entries(dir: &Path) -> Vec<PathBuf> {
+    let mut out: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|e| e.unwrap().path())
+        .collect();
+    out.sort();
+    out
+}
+
+/// One corpus problem with its domain and plans.
+pub struct CorpusCase {
+    pub dir: PathBuf,
+    pub domain: PathBuf,
+    pub problem: PathBuf,
+    pub plans: Vec<PathBuf>,
+}
+
+/// Every corpus problem (found by walking the corpus, not by a list), in
+/// path order; `None` (after [`skip`]) without the corpus.
+pub fn corpus_cases() -> Option<Vec<CorpusCase>> {
+    let name = |p: &Path| p.file_name().unwrap().to_string_lossy().into_owned();
+    let mut out = Vec::new();
+    for dir in sorted_entries(&corpus()?).into_iter().filter(|d| d.is_dir()) {
+        let files = sorted_entries(&dir);
+        for problem in files
+            .iter()
+            .filter(|p| name(p).ends_with(".pddl") && !name(p).contains("domain"))
+        {
+            let stem = problem.file_stem().unwrap().to_string_lossy().into_owned();
+            // `domain.pddl`, or `pNN-domain.pddl` beside `pNN.pddl`
+            let own = dir.join(format!("{stem}-domain.pddl"));
+            let domain = if own.exists() {
+                own
+            } else {
+                dir.join("domain.pddl")
+            };
+            let plans = files
+                .iter()
+                .filter(|p| {
+                    let n = name(p);
+                    n.starts_with(&format!("{stem}."))
+                        && (n.ends_with(".plan") || n.ends_with(".tplan"))
+                })
+                .cloned()
+                .collect();
+            out.push(CorpusCase {
+                dir: dir.clone(),
+                domain,
+                problem: problem.clone(),
+                plans,
+            });
+        }
+    }
+    Some(out)
+}
+
 /// The IPC corpus (`BTC_CORPUS`, or `../shared/corpus/ipc` beside the
 /// repository), or `None` after [`skip`].
 pub fn corpus() -> Option<PathBuf> {

@@ -35,19 +35,9 @@ pub enum Replay {
 }
 
 /// Replays `steps` (from [`crate::plan::type_plan`], with no typing
-/// errors) on `world`, the world of `domain` and `problem`.
+/// errors) on `world`, the world of `domain` and `problem`, as `replay`
+/// says ([`Replay::Cached`] but to test it).
 pub fn validate(
-    world: &World,
-    domain: &Domain,
-    problem: &Problem,
-    plan: &Plan,
-    steps: &[GroundStep],
-) -> Validation {
-    validate_by(Replay::Cached, world, domain, problem, plan, steps)
-}
-
-/// [`validate`], replaying as `replay` says.
-pub fn validate_by(
     replay: Replay,
     world: &World,
     domain: &Domain,
@@ -164,5 +154,12 @@ pub fn validate_plan(
     steps: &[GroundStep],
 ) -> Result<Validation, String> {
     let world = World::of_checked(domain, dix, problem, pix)?;
-    Ok(validate(&world, domain, problem, plan, steps))
+    Ok(validate(
+        Replay::Cached,
+        &world,
+        domain,
+        problem,
+        plan,
+        steps,
+    ))
 }

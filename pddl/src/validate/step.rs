@@ -199,23 +199,33 @@ impl StepCtx<'_> {
         written: &[Formula],
         phase: &str,
     ) -> Result<(), Diagnostic> {
-        let (world, g) = (self.world, self.g);
+        let world = self.world;
         for (c, f) in conds.iter().zip(written) {
             if !world.holds(state, c, self.binding, self.duration) {
                 let (why, path) = world.why_not(state, c, self.binding, self.duration);
-                return Err(Diagnostic::error(
-                    codes::PRECONDITION_FAILS,
-                    self.plan.steps[g.step].span,
-                    format!(
-                        "step {} `{}`: {phase} does not hold: {why}",
-                        g.step + 1,
-                        show_step(world, self.action, g)
-                    ),
-                )
-                .with_label(logic::span_at(f, &path), "this condition fails"));
+                return Err(self
+                    .error(
+                        codes::PRECONDITION_FAILS,
+                        format_args!("{phase} does not hold: {why}"),
+                    )
+                    .with_label(logic::span_at(f, &path), "this condition fails"));
             }
         }
         Ok(())
+    }
+
+    /// An error at the step's line: `step N `(action args)`: {what}`.
+    fn error(&self, code: crate::diagnostic::Code, what: std::fmt::Arguments) -> Diagnostic {
+        let g = self.g;
+        Diagnostic::error(
+            code,
+            self.plan.steps[g.step].span,
+            format!(
+                "step {} `{}`: {what}",
+                g.step + 1,
+                show_step(self.world, self.action, g)
+            ),
+        )
     }
 
     /// A phase's effects by its cached atoms (numeric updates still
@@ -270,25 +280,20 @@ impl StepCtx<'_> {
     /// Gathers the changes of `effects` in `state`; fails on a numeric
     /// update of a fluent with no value.
     fn collect(&mut self, state: &State, effects: &[Eff]) -> Result<(), Diagnostic> {
-        let (world, g) = (self.world, self.g);
         for e in effects {
-            world.collect(state, e, self.binding, self.duration, self.changes);
+            self.world
+                .collect(state, e, self.binding, self.duration, self.changes);
         }
         if let Some(err) = self.changes.numeric_errors.first() {
-            return Err(Diagnostic::error(
-                codes::EFFECT_CONFLICT,
-                self.plan.steps[g.step].span,
-                format!(
-                    "step {} `{}`: `{}` has no value to update",
-                    g.step + 1,
-                    show_step(world, self.action, g),
-                    err.fluent
-                ),
-            )
-            .with_label(self.action.name.span, "the action that updates it")
-            .with_hint(
-                "give the function a value in the problem's `:init`, e.g. `(= (total-cost) 0)`",
-            ));
+            return Err(self
+                .error(
+                    codes::EFFECT_CONFLICT,
+                    format_args!("`{}` has no value to update", err.fluent),
+                )
+                .with_label(self.action.name.span, "the action that updates it")
+                .with_hint(
+                    "give the function a value in the problem's `:init`, e.g. `(= (total-cost) 0)`",
+                ));
         }
         Ok(())
     }
