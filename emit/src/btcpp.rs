@@ -344,13 +344,13 @@ fn node(x: &mut Xml, n: &Node, ir: &TreeIr) {
             push_int(&mut x.out, step + 1);
             if let Some(s) = info {
                 let key = (
-                    Arc::as_ptr(&s.action) as *const u8 as usize,
-                    Arc::as_ptr(&s.args) as *const u8 as usize,
+                    Arc::as_ptr(&s.logic.action) as *const u8 as usize,
+                    Arc::as_ptr(&s.logic.args) as *const u8 as usize,
                 );
                 let call = x.step_calls.entry(key).or_insert_with(|| {
                     let mut out = String::from(": (");
-                    escape_attr_into(&mut out, &s.action);
-                    for a in s.args.iter() {
+                    escape_attr_into(&mut out, &s.logic.action);
+                    for a in s.logic.args.iter() {
                         out.push(' ');
                         escape_attr_into(&mut out, a);
                     }
@@ -361,16 +361,19 @@ fn node(x: &mut Xml, n: &Node, ir: &TreeIr) {
             }
             x.out.push('"');
             integer(x, "step", step + 1);
-            x.attr_shared("start_effect", info.and_then(|s| s.eff_start.as_ref()))
-                .attr_shared("end_effect", info.and_then(|s| s.eff_end.as_ref()));
+            x.attr_shared(
+                "start_effect",
+                info.and_then(|s| s.logic.eff_start.as_ref()),
+            )
+            .attr_shared("end_effect", info.and_then(|s| s.logic.eff_end.as_ref()));
             // The step's conditions, so an executor that does not read the
             // domain checks what `btc run` checks (written only when there
             // are some: most steps have just a precondition).
             if let Some(s) = info {
                 for (key, cond) in [
-                    ("start_condition", &s.pre_start),
-                    ("over_all_condition", &s.pre_over_all),
-                    ("end_condition", &s.pre_end),
+                    ("start_condition", &s.logic.pre_start),
+                    ("over_all_condition", &s.logic.pre_over_all),
+                    ("end_condition", &s.logic.pre_end),
                 ] {
                     if cond.is_some() {
                         x.attr_shared(key, cond.as_ref());

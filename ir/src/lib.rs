@@ -261,34 +261,114 @@ pub struct NodeModel {
     pub formula: Option<Formula>,
 }
 
-/// One plan step as compiled.
+/// One plan step as compiled: where it is in the plan, and its logic.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(from = "StepWire", into = "StepWire")]
 pub struct StepInfo {
     pub index: usize,
     /// 1-based line in the plan file.
     pub line: u32,
-    pub action: Arc<str>,
-    pub args: Arc<[String]>,
+    pub skipped: bool,
     pub time: Option<f64>,
     pub duration: Option<f64>,
+    /// Steps that must finish before this one (`steps parallel`).
+    pub after: Vec<usize>,
+    /// Shared between the steps that repeat a ground action (plans repeat
+    /// them a lot: a long plan would otherwise hold one copy of each per
+    /// step); in JSON each step writes its own.
+    pub logic: Arc<StepLogic>,
+}
+
+/// What a step does, the same for every step of its ground action.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StepLogic {
+    pub action: Arc<str>,
+    pub args: Arc<[String]>,
     /// The id of the rule tree it calls; `None` for a skipped step.
     pub rule: Option<Arc<str>>,
-    pub skipped: bool,
     /// Ground conditions and effects, by when they apply. The effects are
     /// the step's: its rule's `effect` when the rule gives one, else the
-    /// PDDL action's. Shared between the steps that repeat a ground action
-    /// (plans repeat them a lot: a long plan would otherwise hold one copy
-    /// of each tree per step); in JSON each step writes its own.
+    /// PDDL action's.
     pub pre_start: Option<Arc<Formula>>,
     pub pre_over_all: Option<Arc<Formula>>,
     pub pre_end: Option<Arc<Formula>>,
     pub eff_start: Option<Arc<Effect>>,
     pub eff_end: Option<Arc<Effect>>,
-    /// Steps that must finish before this one (`steps parallel`).
-    pub after: Vec<usize>,
+}
+
+/// A step as JSON has it: every field of the step and its logic, in the
+/// order IR files have always had them.
+#[derive(Serialize, Deserialize)]
+struct StepWire {
+    index: usize,
+    line: u32,
+    action: Arc<str>,
+    args: Arc<[String]>,
+    time: Option<f64>,
+    duration: Option<f64>,
+    rule: Option<Arc<str>>,
+    skipped: bool,
+    pre_start: Option<Arc<Formula>>,
+    pre_over_all: Option<Arc<Formula>>,
+    pre_end: Option<Arc<Formula>>,
+    eff_start: Option<Arc<Effect>>,
+    eff_end: Option<Arc<Effect>>,
+    after: Vec<usize>,
+}
+
+impl From<StepWire> for StepInfo {
+    fn from(w: StepWire) -> StepInfo {
+        StepInfo {
+            index: w.index,
+            line: w.line,
+            skipped: w.skipped,
+            time: w.time,
+            duration: w.duration,
+            after: w.after,
+            logic: Arc::new(StepLogic {
+                action: w.action,
+                args: w.args,
+                rule: w.rule,
+                pre_start: w.pre_start,
+                pre_over_all: w.pre_over_all,
+                pre_end: w.pre_end,
+                eff_start: w.eff_start,
+                eff_end: w.eff_end,
+            }),
+        }
+    }
+}
+
+impl From<StepInfo> for StepWire {
+    fn from(s: StepInfo) -> StepWire {
+        let l = Arc::unwrap_or_clone(s.logic);
+        StepWire {
+            index: s.index,
+            line: s.line,
+            action: l.action,
+            args: l.args,
+            time: s.time,
+            duration: s.duration,
+            rule: l.rule,
+            skipped: s.skipped,
+            pre_start: l.pre_start,
+            pre_over_all: l.pre_over_all,
+            pre_end: l.pre_end,
+            eff_start: l.eff_start,
+            eff_end: l.eff_end,
+            after: s.after,
+        }
+    }
 }
 
 impl StepInfo {
+    /// `(action arg ...)`
+    pub fn display(&self) -> String {
+        self.logic.display()
+    }
+}
+
+impl StepLogic {
     /// `(action arg ...)`
     pub fn display(&self) -> String {
         let mut s = format!("({}", self.action);

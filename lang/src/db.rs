@@ -1135,11 +1135,21 @@ mod compile_tests {
         let mut first: HashMap<(&str, &[String]), &btc_ir::StepInfo> = HashMap::new();
         let mut effects = HashSet::new();
         for s in &ir.steps {
-            let f = first.entry((&*s.action, s.args.as_ref())).or_insert(s);
-            assert!(same(&f.pre_start, &s.pre_start) && same(&f.pre_over_all, &s.pre_over_all));
-            assert!(same(&f.pre_end, &s.pre_end) && same(&f.eff_start, &s.eff_start));
-            assert!(same(&f.eff_end, &s.eff_end));
-            effects.extend(s.eff_end.as_ref().map(Arc::as_ptr));
+            let f = first
+                .entry((&*s.logic.action, s.logic.args.as_ref()))
+                .or_insert(s);
+            assert!(
+                same(&f.logic.pre_start, &s.logic.pre_start)
+                    && same(&f.logic.pre_over_all, &s.logic.pre_over_all)
+            );
+            assert!(
+                same(&f.logic.pre_end, &s.logic.pre_end)
+                    && same(&f.logic.eff_start, &s.logic.eff_start)
+            );
+            assert!(same(&f.logic.eff_end, &s.logic.eff_end));
+            // The step's whole logic is one value.
+            assert!(Arc::ptr_eq(&f.logic, &s.logic));
+            effects.extend(s.logic.eff_end.as_ref().map(Arc::as_ptr));
         }
         // Every P3 action but WAIT changes something at its end.
         assert_eq!(effects.len(), first.len() - 1);
@@ -1154,7 +1164,7 @@ mod compile_tests {
             .steps
             .iter()
             .filter(|s| s.skipped)
-            .map(|s| (&*s.action, s.args.as_ref()))
+            .map(|s| (&*s.logic.action, s.logic.args.as_ref()))
             .collect();
         assert_eq!(children.len(), first.len() - skipped.len());
         assert!(first.len() < 20, "{} distinct ground actions", first.len());

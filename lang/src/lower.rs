@@ -599,9 +599,7 @@ fn rule_id(r: &Rule, taken: &BTreeSet<String>) -> String {
 /// node below its `Step` boundary.
 #[derive(Clone)]
 struct Lowered {
-    rule: Option<Arc<str>>,
-    eff_start: Option<Arc<logic::Effect>>,
-    eff_end: Option<Arc<logic::Effect>>,
+    logic: Arc<StepLogic>,
     child: Option<Arc<Node>>,
 }
 
@@ -674,40 +672,39 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
         });
         let repeated = parts.lowered.clone();
         let ground = parts.ground.clone();
-        let mut info = StepInfo {
+        let place = |skipped: bool, logic: Arc<StepLogic>| StepInfo {
             index: k,
             line: step.line,
-            action: parts.action.clone(),
-            args: parts.args.clone(),
+            skipped,
             time: step.time,
             duration: step.duration,
+            after: Vec::new(),
+            logic,
+        };
+        let mut logic = StepLogic {
+            action: parts.action.clone(),
+            args: parts.args.clone(),
             rule: None,
-            skipped: false,
             pre_start: ground.pre_start,
             pre_over_all: ground.pre_over_all,
             pre_end: ground.pre_end,
             eff_start: ground.eff_start,
             eff_end: ground.eff_end,
-            after: Vec::new(),
         };
         if let Some(r) = repeated {
-            info.rule = r.rule;
-            info.skipped = info.rule.is_none();
-            info.eff_start = r.eff_start;
-            info.eff_end = r.eff_end;
+            infos.push(place(r.logic.rule.is_none(), r.logic));
             step_nodes.push(r.child.map(|child| Node::Step { step: k, child }));
-            infos.push(info);
             continue;
         }
         let diags_before = diags.len();
-        let args = &info.args;
+        let args = logic.args.clone();
         // Names match once per (rule, action); steps repeat actions a lot.
         let found = input.rules.iter().enumerate().find_map(|(ri, r)| {
             let caps = name_matches
                 .entry((ri, g.action))
                 .or_insert_with(|| match_name(&r.pattern.name, &action.name.name))
                 .as_ref()?;
-            match_args(r, caps, args, &tables, &types).map(|b| (ri, *r, b))
+            match_args(r, caps, &args, &tables, &types).map(|b| (ri, *r, b))
         });
         let Some((ri, rule, bindings)) = found else {
             let named: Vec<&&Rule> = input
@@ -736,25 +733,23 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
                 Diagnostic::error(
                     codes::R_NO_RULE,
                     step.span,
-                    format!("step {} `{}`: no rule matches it", k + 1, info.display()),
+                    format!("step {} `{}`: no rule matches it", k + 1, logic.display()),
                 )
                 .with_hint(hint),
             );
-            infos.push(info);
+            infos.push(place(false, Arc::new(logic)));
             step_nodes.push(None);
             continue;
         };
         let RuleBody::Template { body, effect } = &rule.body else {
-            info.skipped = true;
+            let logic = Arc::new(logic);
             let done = Lowered {
-                rule: None,
-                eff_start: info.eff_start.clone(),
-                eff_end: info.eff_end.clone(),
+                logic: logic.clone(),
                 child: None,
             };
             calls.get_mut(&call).expect("entered above").lowered = Some(done.clone());
             lowered.insert((g.action, &g.args[..]), done);
-            infos.push(info);
+            infos.push(place(true, logic));
             step_nodes.push(None);
             continue;
         };
@@ -765,8 +760,8 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
             let lifted = rule_effects.entry(ri).or_insert_with(|| RuleEffect::new(e));
             match lifted.ground(&bindings) {
                 Ok(e) => {
-                    info.eff_start = None;
-                    info.eff_end = e.map(Arc::new);
+                    logic.eff_start = None;
+                    logic.eff_end = e.map(Arc::new);
                 }
                 Err(var) => {
                     diags.push(
@@ -776,7 +771,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
                             format!(
                                 "step {} `{}`: its rule's effect reads `?{var}`, which this step leaves out",
                                 k + 1,
-                                info.display()
+                                logic.display()
                             ),
                         )
                         .with_hint("an optional parameter the step does not give cannot stand in the rule's `effect`; write a rule for the shorter form"),
@@ -859,7 +854,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
                         format!(
                             "step {} `{}`: `{}` gets {}, which is not a number of {} from {} to {}",
                             k + 1,
-                            info.display(),
+                            logic.display(),
                             d.keyword(),
                             match v {
                                 PortValue::Text(t) if t.is_empty() => "no value".to_owned(),
@@ -885,19 +880,19 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
                 Diagnostic::error(
                     codes::R_STEP_TYPE,
                     step.span,
-                    format!("step {} `{}`: `{obj}` does not fit port `{port}` of `{node}`, which takes a `{ty}`", k + 1, info.display()),
+                    format!("step {} `{}`: `{obj}` does not fit port `{port}` of `{node}`, which takes a `{ty}`", k + 1, logic.display()),
                 )
                 .with_hint("narrow the rule with a guard such as `where ?x - TYPE`, or widen the port's type"),
             );
             },
         );
-        info.rule = Some(rt.shared_id.clone());
+        logic.rule = Some(rt.shared_id.clone());
         let mut child = Node::SubTree {
             scripts: Default::default(),
             id: rt.id.clone(),
             ports,
         };
-        if let Some(over) = &info.pre_over_all {
+        if let Some(over) = &logic.pre_over_all {
             child = Node::Control {
                 scripts: Default::default(),
                 control: ControlKind::ReactiveSequence,
@@ -908,17 +903,18 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
         let child = Arc::new(child);
         // A step with a diagnostic is not reused: each step reports its own.
         if diags.len() == diags_before {
+            let logic = Arc::new(logic);
             let done = Lowered {
-                rule: info.rule.clone(),
-                eff_start: info.eff_start.clone(),
-                eff_end: info.eff_end.clone(),
+                logic: logic.clone(),
                 child: Some(Arc::clone(&child)),
             };
             calls.get_mut(&call).expect("entered above").lowered = Some(done.clone());
             lowered.insert((g.action, &g.args[..]), done);
+            infos.push(place(false, logic));
+        } else {
+            infos.push(place(false, Arc::new(logic)));
         }
         step_nodes.push(Some(Node::Step { step: k, child }));
-        infos.push(info);
     }
     if !diags.is_empty() {
         return Err(diags);

@@ -58,7 +58,10 @@ fn every_plan_of_the_covered_domains_compiles() {
             let ir = compile(&db, job)
                 .as_ref()
                 .unwrap_or_else(|e| panic!("{}: {e:#?}", plan.display()));
-            assert!(ir.steps.iter().all(|s| !s.skipped || s.rule.is_none()));
+            assert!(ir
+                .steps
+                .iter()
+                .all(|s| !s.skipped || s.logic.rule.is_none()));
             for (format, _) in Format::ALL.iter().filter(|(f, _)| *f != Format::Pytrees) {
                 assert!(!emit(ir, *format, &Options::default()).is_empty());
             }

@@ -381,19 +381,21 @@ fn step(index: usize, args: &[&str], eff_end: Effect) -> StepInfo {
     StepInfo {
         index,
         line: index as u32 + 1,
-        action: "mo\"ve\n".into(),
-        args: args.iter().map(|s| (*s).into()).collect(),
         time: None,
         duration: Some(1.0),
-        rule: Some("rule \"\"\"x".into()),
         skipped: false,
-        pre_start: Some(fact("at", &args[..2]).into()),
-        pre_over_all: None,
-        pre_end: None,
-        // Step 2 starts by deleting the fact step 1 added.
-        eff_start: (index == 1).then(|| Effect::Delete(atom("at", &args[..2])).into()),
-        eff_end: Some(eff_end.into()),
         after: Vec::new(),
+        logic: std::sync::Arc::new(btc_ir::StepLogic {
+            action: "mo\"ve\n".into(),
+            args: args.iter().map(|s| (*s).into()).collect(),
+            rule: Some("rule \"\"\"x".into()),
+            pre_start: Some(fact("at", &args[..2]).into()),
+            pre_over_all: None,
+            pre_end: None,
+            // Step 2 starts by deleting the fact step 1 added.
+            eff_start: (index == 1).then(|| Effect::Delete(atom("at", &args[..2])).into()),
+            eff_end: Some(eff_end.into()),
+        }),
     }
 }
 

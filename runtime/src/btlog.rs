@@ -329,30 +329,36 @@ impl Writer<'_, '_> {
                         "start_effect".into(),
                         text(
                             start_effect.as_deref(),
-                            info.and_then(|s| s.eff_start.as_deref()),
+                            info.and_then(|s| s.logic.eff_start.as_deref()),
                         ),
                     ),
                     (
                         "end_effect".into(),
                         text(
                             end_effect.as_deref(),
-                            info.and_then(|s| s.eff_end.as_deref()),
+                            info.and_then(|s| s.logic.eff_end.as_deref()),
                         ),
                     ),
                     (
                         "start_condition".into(),
-                        text(c.start.as_ref(), info.and_then(|s| s.pre_start.as_deref())),
+                        text(
+                            c.start.as_ref(),
+                            info.and_then(|s| s.logic.pre_start.as_deref()),
+                        ),
                     ),
                     (
                         "over_all_condition".into(),
                         text(
                             c.over_all.as_ref(),
-                            info.and_then(|s| s.pre_over_all.as_deref()),
+                            info.and_then(|s| s.logic.pre_over_all.as_deref()),
                         ),
                     ),
                     (
                         "end_condition".into(),
-                        text(c.end.as_ref(), info.and_then(|s| s.pre_end.as_deref())),
+                        text(
+                            c.end.as_ref(),
+                            info.and_then(|s| s.logic.pre_end.as_deref()),
+                        ),
                     ),
                 ]
             }

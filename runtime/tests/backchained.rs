@@ -55,7 +55,7 @@ fn after<'w>(w: &'w World, ir: &TreeIr, run: &[usize], k: usize) -> Kb<'w> {
     let mut kb = Kb::new(w);
     for &i in &run[..k] {
         let s = &ir.steps[i];
-        for e in [&s.eff_start, &s.eff_end].into_iter().flatten() {
+        for e in [&s.logic.eff_start, &s.logic.eff_end].into_iter().flatten() {
             let id = kb.effect(e).unwrap();
             kb.apply(id);
         }
@@ -69,7 +69,7 @@ fn needed(kb: &Kb, ir: &TreeIr, later: &[usize]) -> Vec<(String, Key)> {
     let mut out: Vec<(String, Key)> = Vec::new();
     for &i in later {
         let s = &ir.steps[i];
-        for f in [&s.pre_start, &s.pre_over_all, &s.pre_end]
+        for f in [&s.logic.pre_start, &s.logic.pre_over_all, &s.logic.pre_end]
             .into_iter()
             .flatten()
         {

@@ -15,6 +15,7 @@ fn the_final_kb_shows_the_rules_effect_from_the_ir_and_from_the_xml() {
     // The IR's steps carry the rule's effect.
     assert_eq!(
         ex.ir.steps[0]
+            .logic
             .eff_end
             .as_ref()
             .map(|e| e.to_string())

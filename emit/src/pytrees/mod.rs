@@ -336,8 +336,8 @@ impl<'a> Emitter<'a> {
         for (s, k) in self.ir.steps.iter().zip(of_step) {
             rows.start(o);
             let args = tuples
-                .entry(Arc::as_ptr(&s.args) as *const u8 as usize)
-                .or_insert_with(|| args_tuple(&s.args).into());
+                .entry(Arc::as_ptr(&s.logic.args) as *const u8 as usize)
+                .or_insert_with(|| args_tuple(&s.logic.args).into());
             row_of(s, k, args, o);
             // Room after the rows for the leaf classes and the rule trees.
             rows.written(o, 65_536);
@@ -651,26 +651,29 @@ fn logic_addresses(s: &StepInfo) -> [usize; 7] {
         v.as_ref().map_or(0, |a| Arc::as_ptr(a) as usize)
     }
     [
-        Arc::as_ptr(&s.action) as *const u8 as usize,
-        Arc::as_ptr(&s.args) as *const u8 as usize,
-        at(&s.pre_start),
-        at(&s.pre_over_all),
-        at(&s.pre_end),
-        at(&s.eff_start),
-        at(&s.eff_end),
+        Arc::as_ptr(&s.logic.action) as *const u8 as usize,
+        Arc::as_ptr(&s.logic.args) as *const u8 as usize,
+        at(&s.logic.pre_start),
+        at(&s.logic.pre_over_all),
+        at(&s.logic.pre_end),
+        at(&s.logic.eff_start),
+        at(&s.logic.eff_end),
     ]
 }
 
 /// `(action, pre_start, pre_over_all, pre_end, eff_start, eff_end)`, lifted.
 fn shape_of(s: &StepInfo, out: &mut String) {
     out.push('(');
-    push_py_str(out, &s.action);
-    let mut e = encode::Encoder { out, args: &s.args };
-    for f in [&s.pre_start, &s.pre_over_all, &s.pre_end] {
+    push_py_str(out, &s.logic.action);
+    let mut e = encode::Encoder {
+        out,
+        args: &s.logic.args,
+    };
+    for f in [&s.logic.pre_start, &s.logic.pre_over_all, &s.logic.pre_end] {
         e.out.push_str(", ");
         e.opt_formula(f.as_deref());
     }
-    for x in [&s.eff_start, &s.eff_end] {
+    for x in [&s.logic.eff_start, &s.logic.eff_end] {
         e.out.push_str(", ");
         e.opt_effect(x.as_deref());
     }

@@ -27,14 +27,21 @@ pub(super) fn kb_holds(f: Arc<Formula>, name: Option<String>) -> Node {
 /// conjunctions; `None` otherwise (such a step is ordered conservatively).
 fn step_literals(info: &StepInfo) -> Option<(Vec<Literal>, Vec<Literal>)> {
     let mut pre = Vec::new();
-    for f in [&info.pre_start, &info.pre_over_all, &info.pre_end]
-        .into_iter()
-        .flatten()
+    for f in [
+        &info.logic.pre_start,
+        &info.logic.pre_over_all,
+        &info.logic.pre_end,
+    ]
+    .into_iter()
+    .flatten()
     {
         pre.extend(f.literals()?);
     }
     let mut eff = Vec::new();
-    for e in [&info.eff_start, &info.eff_end].into_iter().flatten() {
+    for e in [&info.logic.eff_start, &info.logic.eff_end]
+        .into_iter()
+        .flatten()
+    {
         eff.extend(e.literals()?);
     }
     Some((pre, eff))

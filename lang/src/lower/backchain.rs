@@ -219,15 +219,15 @@ fn plain_step(info: &StepInfo, derived: &BTreeSet<Name>, opaque: &mut Opaque) ->
         None => Vec::new(),
         Some(f) => condition(f, derived, opaque),
     };
-    let mut pre_later = cond(&info.pre_over_all);
-    pre_later.extend(cond(&info.pre_end));
-    let pre_start = cond(&info.pre_start);
+    let mut pre_later = cond(&info.logic.pre_over_all);
+    pre_later.extend(cond(&info.logic.pre_end));
+    let pre_start = cond(&info.logic.pre_start);
     let eff = |e: &Option<Arc<Effect>>| e.as_deref().map(StepEffect::of).unwrap_or_default();
     PlainStep {
         pre_start,
         pre_later,
-        eff_start: eff(&info.eff_start),
-        eff_end: eff(&info.eff_end),
+        eff_start: eff(&info.logic.eff_start),
+        eff_end: eff(&info.logic.eff_end),
     }
 }
 

@@ -125,11 +125,11 @@ impl<'w> Engine<'w> {
                 ..StepRt::default()
             };
             if !s.skipped {
-                rt.pre_start = self.kb_formula(s.pre_start.as_deref(), &rt.label)?;
-                rt.pre_over_all = self.kb_formula(s.pre_over_all.as_deref(), &rt.label)?;
-                rt.pre_end = self.kb_formula(s.pre_end.as_deref(), &rt.label)?;
-                rt.eff_start = self.kb_effect(s.eff_start.as_deref(), &rt.label)?;
-                rt.eff_end = self.kb_effect(s.eff_end.as_deref(), &rt.label)?;
+                rt.pre_start = self.kb_formula(s.logic.pre_start.as_deref(), &rt.label)?;
+                rt.pre_over_all = self.kb_formula(s.logic.pre_over_all.as_deref(), &rt.label)?;
+                rt.pre_end = self.kb_formula(s.logic.pre_end.as_deref(), &rt.label)?;
+                rt.eff_start = self.kb_effect(s.logic.eff_start.as_deref(), &rt.label)?;
+                rt.eff_end = self.kb_effect(s.logic.eff_end.as_deref(), &rt.label)?;
             }
             self.steps.push(rt);
         }
