@@ -74,7 +74,10 @@ pub struct CorpusCase {
 pub fn corpus_cases() -> Option<Vec<CorpusCase>> {
     let name = |p: &Path| p.file_name().unwrap().to_string_lossy().into_owned();
     let mut out = Vec::new();
-    for dir in sorted_entries(&corpus()?).into_iter().filter(|d| d.is_dir()) {
+    for dir in sorted_entries(&corpus()?)
+        .into_iter()
+        .filter(|d| d.is_dir())
+    {
         let files = sorted_entries(&dir);
         for problem in files
             .iter()
