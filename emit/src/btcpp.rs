@@ -6,7 +6,7 @@
 //!
 //! `SubTree` elements get no `name` attribute: Groot2's monitor crashes on it.
 
-use crate::sizing::{StepSizer, SAMPLE_STEPS};
+use crate::sizing::{steps_with_nodes, StepSizer, SAMPLE_STEPS};
 use btc_ir::*;
 use std::fmt::Write as _;
 use std::sync::Arc;
@@ -408,7 +408,7 @@ pub fn emit(ir: &TreeIr, inline: bool) -> String {
     // Room for the first steps; the rest is sized as they are written.
     let estimate = 4096 + ir.steps.len().min(SAMPLE_STEPS) * 512 + ir.trees.len() * 2048;
     let mut x = Xml::new(estimate);
-    x.sizer = StepSizer::new(ir.steps.len());
+    x.sizer = StepSizer::new(steps_with_nodes(ir));
     x.open("root")
         .attr("BTCPP_format", "4")
         .attr("main_tree_to_execute", &ir.main_tree)

@@ -8,6 +8,13 @@
 /// Steps written before the buffer is sized for the rest.
 pub(crate) const SAMPLE_STEPS: usize = 256;
 
+/// How many steps have a node in the main tree: a skipped step has none,
+/// and sizing a step node's text by every step would reserve a fifth too
+/// much for a plan that skips as many as P3's.
+pub(crate) fn steps_with_nodes(ir: &btc_ir::TreeIr) -> usize {
+    ir.steps.iter().filter(|s| !s.skipped).count()
+}
+
 /// Counts the steps of one run of per-step text (rows, nodes) as they are
 /// written and sizes the buffer once the sample is in.
 #[derive(Debug)]

@@ -17,7 +17,7 @@
 mod encode;
 pub mod names;
 
-use crate::sizing::{StepSizer, SAMPLE_STEPS};
+use crate::sizing::{steps_with_nodes, StepSizer, SAMPLE_STEPS};
 use btc_ir::vocab::{NodeSpec, PyTrees};
 use btc_ir::Count;
 use btc_ir::{push_int, Label, LabelPart, LeafKind, Node, NodeModel, Port, StepInfo, TreeIr};
@@ -119,7 +119,7 @@ pub fn emit(ir: &TreeIr, options: &PyOptions<'_>) -> String {
             .map(|(i, t)| (t.id.as_str(), i))
             .collect(),
         step_nodes: Default::default(),
-        root_sizer: std::cell::RefCell::new(StepSizer::new(ir.steps.len())),
+        root_sizer: std::cell::RefCell::new(StepSizer::new(steps_with_nodes(ir))),
     };
     e.header(options);
     e.world();
