@@ -121,6 +121,9 @@ struct Xml {
     /// Steps' `(action arg ...)` as escaped text, by the addresses of the
     /// shared action and arguments.
     step_calls: rustc_hash::FxHashMap<(usize, usize), Box<str>>,
+    /// Steps' text after their number, by the addresses of their shared
+    /// logic and child and the depth.
+    step_tails: rustc_hash::FxHashMap<(usize, usize, usize), Box<str>>,
     /// Sizes the buffer by the plan's first steps.
     sizer: StepSizer,
 }
@@ -136,6 +139,7 @@ impl Xml {
             shared: Default::default(),
             step_nodes: Default::default(),
             step_calls: Default::default(),
+            step_tails: Default::default(),
             sizer: StepSizer::new(0),
         }
     }
@@ -361,32 +365,56 @@ fn node(x: &mut Xml, n: &Node, ir: &TreeIr) {
             }
             x.out.push('"');
             integer(x, "step", step + 1);
-            x.attr_shared(
-                "start_effect",
-                info.and_then(|s| s.logic.eff_start.as_ref()),
-            )
-            .attr_shared("end_effect", info.and_then(|s| s.logic.eff_end.as_ref()));
-            // The step's conditions, so an executor that does not read the
-            // domain checks what `btc run` checks (written only when there
-            // are some: most steps have just a precondition).
-            if let Some(s) = info {
-                for (key, cond) in [
-                    ("start_condition", &s.logic.pre_start),
-                    ("over_all_condition", &s.logic.pre_over_all),
-                    ("end_condition", &s.logic.pre_end),
-                ] {
-                    if cond.is_some() {
-                        x.attr_shared(key, cond.as_ref());
+            // What follows the step's number is its logic's and its
+            // child's: written once for the steps that share both.
+            match info.filter(|s| Arc::strong_count(&s.logic) > 1) {
+                Some(s) => {
+                    let key = (
+                        Arc::as_ptr(&s.logic) as usize,
+                        Arc::as_ptr(child) as usize,
+                        x.depth,
+                    );
+                    if let Some(text) = x.step_tails.get(&key) {
+                        x.out.push_str(text);
+                    } else {
+                        let start = x.out.len();
+                        step_tail(x, info, child, ir);
+                        let text = x.out[start..].into();
+                        x.step_tails.insert(key, text);
                     }
                 }
+                None => step_tail(x, info, child, ir),
             }
-            x.close(false);
-            shared_node(x, child, ir);
-            x.end("KbStep");
             // Room after the steps for the rule trees and the models.
             x.sizer.written(&mut x.out, 65_536);
         }
     }
+}
+
+/// A `KbStep`'s effects and conditions, its child and its end tag.
+fn step_tail(x: &mut Xml, info: Option<&StepInfo>, child: &Arc<Node>, ir: &TreeIr) {
+    x.attr_shared(
+        "start_effect",
+        info.and_then(|s| s.logic.eff_start.as_ref()),
+    )
+    .attr_shared("end_effect", info.and_then(|s| s.logic.eff_end.as_ref()));
+    // The step's conditions, so an executor that does not read the
+    // domain checks what `btc run` checks (written only when there
+    // are some: most steps have just a precondition).
+    if let Some(s) = info {
+        for (key, cond) in [
+            ("start_condition", &s.logic.pre_start),
+            ("over_all_condition", &s.logic.pre_over_all),
+            ("end_condition", &s.logic.pre_end),
+        ] {
+            if cond.is_some() {
+                x.attr_shared(key, cond.as_ref());
+            }
+        }
+    }
+    x.close(false);
+    shared_node(x, child, ir);
+    x.end("KbStep");
 }
 
 /// [`node`] of a node that steps share: written once per depth, then
