@@ -118,9 +118,9 @@ struct Xml {
     /// Steps' nodes as XML, by the address of the shared node and the
     /// depth they were written at.
     step_nodes: rustc_hash::FxHashMap<(usize, usize), Box<str>>,
-    /// Steps' `(action arg ...)` as escaped text, by the addresses of the
-    /// shared action and arguments.
-    step_calls: rustc_hash::FxHashMap<(usize, usize), Box<str>>,
+    /// Steps' `(action arg ...)` as escaped text, by the address of their
+    /// shared logic.
+    step_calls: rustc_hash::FxHashMap<usize, Box<str>>,
     /// Steps' text after their number, by the addresses of their shared
     /// logic and child and the depth.
     step_tails: rustc_hash::FxHashMap<(usize, usize, usize), Box<str>>,
@@ -347,10 +347,7 @@ fn node(x: &mut Xml, n: &Node, ir: &TreeIr) {
             x.out.push_str(" name=\"step ");
             push_int(&mut x.out, step + 1);
             if let Some(s) = info {
-                let key = (
-                    Arc::as_ptr(&s.logic.action) as *const u8 as usize,
-                    Arc::as_ptr(&s.logic.args) as *const u8 as usize,
-                );
+                let key = Arc::as_ptr(&s.logic) as usize;
                 let call = x.step_calls.entry(key).or_insert_with(|| {
                     let mut out = String::from(": (");
                     escape_attr_into(&mut out, &s.logic.action);

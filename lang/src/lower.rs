@@ -613,6 +613,28 @@ struct CallParts {
     lowered: Option<Lowered>,
 }
 
+/// A step's call: its action and the address of its shared argument list.
+type CallKey = (usize, *const u32);
+
+fn call_key(g: &GroundStep) -> CallKey {
+    (g.action, Arc::as_ptr(&g.args) as *const u32)
+}
+
+/// Remembers how the call of step `g` lowered, for the steps that repeat
+/// it: by the call, and by its action and objects for steps that repeat
+/// it in another call (written otherwise).
+fn remember<'a>(
+    calls: &mut rustc_hash::FxHashMap<CallKey, CallParts>,
+    lowered: &mut rustc_hash::FxHashMap<(usize, &'a [u32]), Lowered>,
+    g: &'a GroundStep,
+    done: Lowered,
+) {
+    if let Some(parts) = calls.get_mut(&call_key(g)) {
+        parts.lowered = Some(done.clone());
+    }
+    lowered.insert((g.action, &g.args[..]), done);
+}
+
 /// Lowers a plan; every problem is reported at the plan line of its step.
 pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
     let mut diags = Vec::new();
@@ -631,7 +653,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
     let mut action_names: rustc_hash::FxHashMap<usize, Arc<str>> = Default::default();
     let mut arg_names: rustc_hash::FxHashMap<&[u32], Arc<[String]>> = Default::default();
     // The same, by call: one lookup a step instead of one a table.
-    let mut calls: rustc_hash::FxHashMap<(usize, *const u32), CallParts> = Default::default();
+    let mut calls: rustc_hash::FxHashMap<CallKey, CallParts> = Default::default();
     let mut rule_effects: BTreeMap<usize, RuleEffect> = BTreeMap::new();
     let mut rule_trees: Vec<(usize, RuleTree)> = Vec::new(); // by rule index
     let mut taken = BTreeSet::new();
@@ -652,8 +674,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
     for (k, g) in input.steps.iter().enumerate() {
         let step = &input.plan.steps[g.step];
         let action = &input.domain.actions[g.action];
-        let call = (g.action, Arc::as_ptr(&g.args) as *const u32);
-        let parts = calls.entry(call).or_insert_with(|| CallParts {
+        let parts = calls.entry(call_key(g)).or_insert_with(|| CallParts {
             action: action_names
                 .entry(g.action)
                 .or_insert_with(|| action.name.name.as_str().into())
@@ -747,8 +768,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
                 logic: logic.clone(),
                 child: None,
             };
-            calls.get_mut(&call).expect("entered above").lowered = Some(done.clone());
-            lowered.insert((g.action, &g.args[..]), done);
+            remember(&mut calls, &mut lowered, g, done);
             infos.push(place(true, logic));
             step_nodes.push(None);
             continue;
@@ -908,8 +928,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
                 logic: logic.clone(),
                 child: Some(Arc::clone(&child)),
             };
-            calls.get_mut(&call).expect("entered above").lowered = Some(done.clone());
-            lowered.insert((g.action, &g.args[..]), done);
+            remember(&mut calls, &mut lowered, g, done);
             infos.push(place(false, logic));
         } else {
             infos.push(place(false, Arc::new(logic)));

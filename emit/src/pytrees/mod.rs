@@ -292,13 +292,14 @@ impl<'a> Emitter<'a> {
         // module after the shapes, not through a second buffer as large
         // as the plan.
         let mut of_step: Vec<usize> = Vec::with_capacity(self.ir.steps.len());
-        // Steps that repeat a ground action share its action, arguments
-        // and logic (the same values, not equal copies): their shape is
-        // found once, by the values' addresses.
-        let mut by_logic: rustc_hash::FxHashMap<[usize; 7], usize> = Default::default();
+        // Steps that repeat a ground action share its logic (the same
+        // value, not equal copies): their shape is found once, by the
+        // value's address.
+        let mut by_logic: rustc_hash::FxHashMap<*const btc_ir::StepLogic, usize> =
+            Default::default();
         let mut buf = String::new();
         for s in &self.ir.steps {
-            let logic = logic_addresses(s);
+            let logic = Arc::as_ptr(&s.logic);
             if let Some(&k) = by_logic.get(&logic) {
                 of_step.push(k);
                 continue;
@@ -642,23 +643,6 @@ fn push_opt_name(o: &mut String, name: &Option<Label>) {
         [LabelPart::Text(t)] => push_py_str(o, t),
         _ => push_py_str(o, &n.braced()),
     }
-}
-
-/// Where a step's action, arguments, conditions and effects are (0 for
-/// none): two steps with the same addresses have the same shape.
-fn logic_addresses(s: &StepInfo) -> [usize; 7] {
-    fn at<T>(v: &Option<Arc<T>>) -> usize {
-        v.as_ref().map_or(0, |a| Arc::as_ptr(a) as usize)
-    }
-    [
-        Arc::as_ptr(&s.logic.action) as *const u8 as usize,
-        Arc::as_ptr(&s.logic.args) as *const u8 as usize,
-        at(&s.logic.pre_start),
-        at(&s.logic.pre_over_all),
-        at(&s.logic.pre_end),
-        at(&s.logic.eff_start),
-        at(&s.logic.eff_end),
-    ]
 }
 
 /// `(action, pre_start, pre_over_all, pre_end, eff_start, eff_end)`, lifted.
