@@ -10,6 +10,7 @@ use btc_lang::targets;
 use btc_pddl::diagnostic::{has_errors, Diagnostic, Severity};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::Arc;
 
 /// Loads a rules file and everything it names from disk.
 pub fn load_rules(db: &mut Database, path: &Path) -> anyhow::Result<SourceFile> {
@@ -174,10 +175,10 @@ pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
     let mut result = if has_errors(&job.diagnostics) {
         None
     } else {
-        db::compile(&job.db, job.job()).as_ref().ok()
+        db::compile(&job.db, job.job()).as_ref().ok().cloned()
     };
     // What the target cannot express is refused, never approximated.
-    if let (Some(ir), Output::Tree(emit::Format::Pytrees)) = (result, a.emit) {
+    if let (Some(ir), Output::Tree(emit::Format::Pytrees)) = (&result, a.emit) {
         let refused = targets::refusals(&job.db, job.job(), ir, targets::Target::Pytrees);
         if !refused.is_empty() {
             job.diagnostics.extend(refused);
@@ -193,9 +194,9 @@ pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
             }
         }
     }
-    let sources = job.db.sources();
+    let sources = job.db.sources_for(&job.diagnostics);
     let json = report::diagnostics(&job.diagnostics, &sources, a.format);
-    let Some(ir) = result else {
+    let Some(mut ir) = result else {
         if a.format == Format::Json {
             println!(
                 "{}",
@@ -208,25 +209,6 @@ pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
         }
         return Ok(ExitCode::from(1));
     };
-    let text = match (&a.output, a.emit) {
-        // A JSON IR records the files it was compiled from relative to
-        // its own folder.
-        (Some(out), Output::Tree(f @ emit::Format::Json)) => {
-            let mut ir = ir.clone();
-            let dir = out.parent().unwrap_or(Path::new(""));
-            for p in [&mut ir.domain, &mut ir.problem, &mut ir.plan, &mut ir.rules] {
-                *p = crate::paths::text(&crate::paths::relative_to(Path::new(p.as_str()), dir));
-            }
-            emit::emit(&ir, f, &a.options)
-        }
-        (_, Output::Tree(f)) => emit::emit(ir, f, &a.options),
-        (_, Output::Kb) => match db::JobWorld::of(&job.db, job.job()) {
-            Some(w) => emit::kb::emit(w.domain, w.dix, w.problem, w.pix),
-            None => anyhow::bail!(
-                "`--emit kb` needs the PDDL problem: pass `--problem PROBLEM` or name it in the rules file"
-            ),
-        },
-    };
     let steps = ir.steps.iter().filter(|s| !s.skipped).count();
     let what = format!(
         "{steps} of {} plan steps ({} skipped); problem {}",
@@ -234,6 +216,34 @@ pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
         ir.steps.len() - steps,
         job.problem_shown()
     );
+    let text = match a.emit {
+        Output::Tree(f) => {
+            // A tree's emitter reads the IR alone: the plan's text, parse
+            // and replay (half of what a long plan's compile holds) are
+            // freed before the output is built, not kept beside it.
+            drop(job);
+            // A JSON IR records the files it was compiled from relative
+            // to its own folder (the IR is ours alone now: no copy).
+            if let (Some(out), emit::Format::Json) = (&a.output, f) {
+                let ir = Arc::make_mut(&mut ir);
+                let dir = out.parent().unwrap_or(Path::new(""));
+                for p in [&mut ir.domain, &mut ir.problem, &mut ir.plan, &mut ir.rules] {
+                    *p = crate::paths::text(&crate::paths::relative_to(Path::new(p.as_str()), dir));
+                }
+            }
+            emit::emit(&ir, f, &a.options)
+        }
+        Output::Kb => {
+            let text = match db::JobWorld::of(&job.db, job.job()) {
+                Some(w) => emit::kb::emit(w.domain, w.dix, w.problem, w.pix),
+                None => anyhow::bail!(
+                    "`--emit kb` needs the PDDL problem: pass `--problem PROBLEM` or name it in the rules file"
+                ),
+            };
+            std::mem::forget(job);
+            text
+        }
+    };
     match &a.output {
         Some(out) => {
             files::write_atomically(out, &text)?;
@@ -254,11 +264,10 @@ pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
             eprintln!("compiled {}: {what}", a.plan.display());
         }
     }
-    // The process ends here: freeing the database and the output piece by
-    // piece would take a tenth of a long plan's compile (the OS reclaims
-    // them at once).
+    // The process ends here: freeing the IR and the output piece by piece
+    // would take time the OS saves by reclaiming them at once.
     std::mem::forget(text);
-    std::mem::forget(job);
+    std::mem::forget(ir);
     Ok(ExitCode::SUCCESS)
 }
 

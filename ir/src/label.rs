@@ -12,10 +12,13 @@
 use crate::{Port, PortValue};
 use serde::{Deserialize, Serialize};
 use std::fmt;
+use thin_vec::{thin_vec, ThinVec};
 
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Label {
-    pub parts: Vec<LabelPart>,
+    /// One pointer wide: every node has an `Option<Label>`, and a long
+    /// plan's main tree has a node per step.
+    pub parts: ThinVec<LabelPart>,
 }
 
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -30,7 +33,7 @@ impl Label {
     /// A name that is text only.
     pub fn text(s: impl Into<String>) -> Label {
         Label {
-            parts: vec![LabelPart::Text(s.into())],
+            parts: thin_vec![LabelPart::Text(s.into())],
         }
     }
 
@@ -83,7 +86,7 @@ impl Label {
     /// that is itself a parameter of the caller stays one.
     pub fn fill(&self, args: &[Port]) -> Label {
         let mut out = Label {
-            parts: Vec::with_capacity(self.parts.len()),
+            parts: ThinVec::with_capacity(self.parts.len()),
         };
         for p in &self.parts {
             match p {
@@ -139,7 +142,7 @@ impl Serialize for Label {
     fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
         match self.as_text() {
             Some(t) => Encoded::Text(t),
-            None => Encoded::Parts(self.parts.clone()),
+            None => Encoded::Parts(self.parts.to_vec()),
         }
         .serialize(s)
     }
@@ -149,7 +152,9 @@ impl<'de> Deserialize<'de> for Label {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Label, D::Error> {
         Ok(match Encoded::deserialize(d)? {
             Encoded::Text(t) => Label::text(t),
-            Encoded::Parts(parts) => Label { parts },
+            Encoded::Parts(parts) => Label {
+                parts: parts.into(),
+            },
         })
     }
 }

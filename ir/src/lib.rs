@@ -15,6 +15,7 @@ use rustc_hash::FxHashSet;
 use serde::{Deserialize, Serialize};
 use std::collections::HashSet;
 use std::sync::Arc;
+pub use thin_vec::ThinVec;
 
 pub mod json;
 mod label;
@@ -271,8 +272,9 @@ pub struct StepInfo {
     pub skipped: bool,
     pub time: Option<f64>,
     pub duration: Option<f64>,
-    /// Steps that must finish before this one (`steps parallel`).
-    pub after: Vec<usize>,
+    /// Steps that must finish before this one (`steps parallel`). One
+    /// pointer wide, as most steps have none and a long plan has many.
+    pub after: ThinVec<usize>,
     /// Shared between the steps that repeat a ground action (plans repeat
     /// them a lot: a long plan would otherwise hold one copy of each per
     /// step); in JSON each step writes its own.
@@ -324,7 +326,7 @@ impl From<StepWire> for StepInfo {
             skipped: w.skipped,
             time: w.time,
             duration: w.duration,
-            after: w.after,
+            after: w.after.into(),
             logic: Arc::new(StepLogic {
                 action: w.action,
                 args: w.args,
@@ -356,7 +358,7 @@ impl From<StepInfo> for StepWire {
             pre_end: l.pre_end,
             eff_start: l.eff_start,
             eff_end: l.eff_end,
-            after: s.after,
+            after: s.after.into(),
         }
     }
 }
@@ -637,6 +639,16 @@ mod float_tests {
 #[cfg(test)]
 mod walk_tests {
     use super::*;
+
+    /// A long plan holds a main-tree node and a `StepInfo` per step, and a
+    /// py_trees compile holds them beside its output: their widths are
+    /// what keeps its peak within 2x the output (#14).
+    #[test]
+    fn a_step_costs_the_ir_at_most_136_bytes() {
+        assert!(std::mem::size_of::<Node>() <= 72);
+        assert!(std::mem::size_of::<StepInfo>() <= 64);
+        assert_eq!(std::mem::size_of::<Option<Label>>(), 8);
+    }
 
     fn leaf(id: &str) -> Node {
         Node::Leaf {

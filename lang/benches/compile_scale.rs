@@ -76,15 +76,20 @@ fn compile_once(plan: &str, format: Format) -> (String, usize, Duration) {
     let r = db.set_file("p3/rules.btrules", RULES.to_owned());
     let l = db.set_file("p3/plan.tplan", plan.to_owned());
     let job = CompileJob::new(&db, r, l, Some(p), None);
-    let ir = compile(&db, job).as_ref().expect("the plan compiles");
+    let ir = compile(&db, job)
+        .as_ref()
+        .expect("the plan compiles")
+        .clone();
+    // As `btc compile` does: the emitter reads the IR alone, so the texts,
+    // the parsed plan and its replay are freed before the output is built.
+    drop(db);
     let options = Options {
         runtime: Runtime::Import,
         ..Options::default()
     };
     let t = Instant::now();
-    let text = emit(ir, format, &options);
+    let text = emit(&ir, format, &options);
     let emitting = t.elapsed();
-    drop(db);
     (text, PEAK.load(Ordering::Relaxed) - base, emitting)
 }
 

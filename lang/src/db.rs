@@ -180,13 +180,30 @@ impl Database {
 
     /// Every file as [`Sources`] with the ids diagnostics use, for rendering.
     pub fn sources(&self) -> Sources {
+        self.sources_where(|_| true)
+    }
+
+    /// The files `diags` point into (their spans, labels and fixes), to
+    /// render them: a long plan's text is not copied to say nothing.
+    pub fn sources_for(&self, diags: &[Diagnostic]) -> Sources {
+        let used: std::collections::BTreeSet<FileId> = diags
+            .iter()
+            .flat_map(|d| {
+                std::iter::once(d.span.file)
+                    .chain(d.labels.iter().map(|l| l.span.file))
+                    .chain(d.fixes.iter().map(|f| f.span.file))
+            })
+            .collect();
+        self.sources_where(|id| used.contains(&id))
+    }
+
+    fn sources_where(&self, keep: impl Fn(FileId) -> bool) -> Sources {
         let mut s = Sources::new();
         for f in self.workspace().files(self).values() {
-            s.insert(
-                file_id(self, *f),
-                f.path(self).to_string(),
-                f.text(self).clone(),
-            );
+            let id = file_id(self, *f);
+            if keep(id) {
+                s.insert(id, f.path(self).to_string(), f.text(self).clone());
+            }
         }
         s
     }
@@ -826,6 +843,30 @@ pub(crate) mod tests {
             .collect()
     }
 
+    /// Rendering diagnostics copies the files they point into (spans,
+    /// labels, fixes) and no other: a long plan is not copied for nothing.
+    #[test]
+    fn sources_for_diagnostics_hold_the_files_they_point_into() {
+        use btc_pddl::diagnostic::Fix;
+        let mut db = Database::new();
+        let mut files = Vec::new();
+        for p in ["a.pddl", "b.pddl", "c.btrules", "plan.txt"] {
+            let f = db.set_file(p, format!("text of {p}"));
+            files.push(file_id(&db, f));
+        }
+        let mut d = Diagnostic::error(codes::INVALID_TOKEN, Span::new(files[0], 0, 1), "here")
+            .with_label(Span::new(files[1], 0, 1), "and there");
+        d.fixes = Box::new([Fix {
+            title: "fix".into(),
+            span: Span::new(files[2], 0, 1),
+            replacement: String::new(),
+        }]);
+        let kept: Vec<FileId> = db.sources_for(&[d]).iter().map(|(id, _)| id).collect();
+        assert_eq!(kept, files[..3]);
+        assert_eq!(db.sources_for(&[]).iter().count(), 0);
+        assert!(db.sources().iter().any(|(id, _)| id == files[3]));
+    }
+
     #[test]
     fn the_design_examples_check_clean() {
         for dir in ["examples/ariac", "examples/p3_assembler"] {
@@ -1019,8 +1060,12 @@ pub fn typed_plan(db: &dyn Db, job: CompileJob) -> TypedPlan {
 
 /// Compiles a job to the tree IR, or returns why not (errors only; see
 /// [`job_diagnostics`] for warnings).
+///
+/// The IR is shared so a caller can keep it and drop the database: a long
+/// plan's text, parse and replay are half of what a compile holds, and an
+/// emitter needs none of them (`btc compile` frees them before it writes).
 #[salsa::tracked(returns(ref))]
-pub fn compile(db: &dyn Db, job: CompileJob) -> Result<btc_ir::TreeIr, Vec<Diagnostic>> {
+pub fn compile(db: &dyn Db, job: CompileJob) -> Result<Arc<btc_ir::TreeIr>, Vec<Diagnostic>> {
     let diags = job_diagnostics(db, job);
     if btc_pddl::diagnostic::has_errors(diags) {
         return Err(diags.iter().filter(|d| d.is_error()).cloned().collect());
@@ -1063,7 +1108,7 @@ pub fn compile(db: &dyn Db, job: CompileJob) -> Result<btc_ir::TreeIr, Vec<Diagn
         plan_path: job.plan(db).path(db).to_string(),
         rules_path: rules.path(db).to_string(),
     };
-    crate::lower::lower(&input)
+    crate::lower::lower(&input).map(Arc::new)
 }
 
 #[cfg(test)]
@@ -1109,6 +1154,20 @@ mod compile_tests {
                 println!("{}", serde_json::to_string_pretty(ir).unwrap());
             }
         }
+    }
+
+    /// The compiled IR outlives the database without a copy: `btc
+    /// compile` frees the database (a long plan's text, parse and replay)
+    /// before it emits.
+    #[test]
+    fn the_ir_outlives_its_database() {
+        let mut db = Database::new();
+        let job = example_job(&mut db, "examples/p3_assembler");
+        let ir = compile(&db, job).as_ref().expect("compiles").clone();
+        let steps = ir.steps.len();
+        drop(db);
+        assert_eq!(Arc::strong_count(&ir), 1);
+        assert_eq!(ir.steps.len(), steps);
     }
 
     /// A long plan repeats few ground actions: lowering grounds each once

@@ -323,7 +323,9 @@ impl Inst<'_> {
     fn name(&mut self, s: &Option<StrLit>) -> Option<Label> {
         let s = s.as_ref()?;
         let parametric = self.params.is_some() && self.tree_ports.is_empty();
-        let mut label = Label { parts: Vec::new() };
+        let mut label = Label {
+            parts: Default::default(),
+        };
         for p in &s.parts {
             let v = match p {
                 StrPart::Text { text } => {
@@ -699,7 +701,7 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
             skipped,
             time: step.time,
             duration: step.duration,
-            after: Vec::new(),
+            after: Default::default(),
             logic,
         };
         let mut logic = StepLogic {

@@ -28,6 +28,8 @@ fn compile_parallel(rules: &str, problem: &str, plan: &str) -> TreeIr {
     compile(&db, job)
         .clone()
         .unwrap_or_else(|e| panic!("{e:#?}"))
+        .as_ref()
+        .clone()
 }
 
 /// Edges `a -> b` (0-based steps) the tree enforces.

@@ -123,6 +123,8 @@ fn compile_dir(dir: &Path, rules: &str) -> TreeIr {
     compile(&db, job)
         .clone()
         .unwrap_or_else(|e| panic!("{prefix}/{rules} does not compile: {e:#?}"))
+        .as_ref()
+        .clone()
 }
 
 fn compile_example(dir: &Path) -> TreeIr {
@@ -384,7 +386,7 @@ fn step(index: usize, args: &[&str], eff_end: Effect) -> StepInfo {
         time: None,
         duration: Some(1.0),
         skipped: false,
-        after: Vec::new(),
+        after: Default::default(),
         logic: std::sync::Arc::new(btc_ir::StepLogic {
             action: "mo\"ve\n".into(),
             args: args.iter().map(|s| (*s).into()).collect(),
@@ -434,7 +436,8 @@ fn hostile_ir() -> TreeIr {
                     LabelPart::Text("go to ".into()),
                     LabelPart::Param("x".into()),
                     LabelPart::Text(" \"\"\" '''\n\\ </div>".into()),
-                ],
+                ]
+                .into(),
             }),
             children: vec![
                 leaf(

@@ -39,6 +39,8 @@ fn compiled(dir: &str, rules: &str, problem: &str, plan: String) -> TreeIr {
     compile(&db, job)
         .clone()
         .unwrap_or_else(|e| panic!("{dir}/{rules}: {e:#?}"))
+        .as_ref()
+        .clone()
 }
 
 /// The IR with nothing shared: every step's logic and node its own.

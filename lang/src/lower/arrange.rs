@@ -75,7 +75,7 @@ pub(super) fn order_steps(infos: &mut [StepInfo]) {
                 after.push(i);
             }
         }
-        infos[j].after = after;
+        infos[j].after = after.into();
     }
 }
 

@@ -108,6 +108,7 @@ pub fn load(rules: &Path, plan: &Path, problem: &Path) -> Example {
     let ir = db::compile(&db, job)
         .as_ref()
         .unwrap_or_else(|e| panic!("{}: {e:#?}", rules.display()))
+        .as_ref()
         .clone();
     Example { db, job, ir }
 }
