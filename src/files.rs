@@ -149,6 +149,16 @@ pub fn write_bytes_atomically(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
         .map_err(|e| anyhow::anyhow!("cannot write `{}`: {e}", path.display()))
 }
 
+/// [`write_atomically`] of what `produce` writes as it makes it (a long
+/// plan's tree is streamed, never whole in memory).
+pub fn write_produced(
+    path: &Path,
+    produce: &mut btc_files::write::Produce<'_>,
+) -> anyhow::Result<()> {
+    btc_files::write_with(path, produce)
+        .map_err(|e| anyhow::anyhow!("cannot write `{}`: {e}", path.display()))
+}
+
 /// Opens an output that is written as it is produced (`--trace`).
 pub fn stream(path: &Path) -> anyhow::Result<btc_files::Stream> {
     btc_files::Stream::create(path)

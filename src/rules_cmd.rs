@@ -8,6 +8,7 @@ use btc_lang::path::FilePath;
 use btc_lang::project::{self, JobPaths, LoadedJob, PlanSource};
 use btc_lang::targets;
 use btc_pddl::diagnostic::{has_errors, Diagnostic, Severity};
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
@@ -216,11 +217,11 @@ pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
         ir.steps.len() - steps,
         job.problem_shown()
     );
-    let text = match a.emit {
+    match a.emit {
         Output::Tree(f) => {
             // A tree's emitter reads the IR alone: the plan's text, parse
             // and replay (half of what a long plan's compile holds) are
-            // freed before the output is built, not kept beside it.
+            // freed before the output is made, not kept beside it.
             drop(job);
             // A JSON IR records the files it was compiled from relative
             // to its own folder (the IR is ours alone now: no copy).
@@ -231,7 +232,7 @@ pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
                     *p = crate::paths::text(&crate::paths::relative_to(Path::new(p.as_str()), dir));
                 }
             }
-            emit::emit(&ir, f, &a.options)
+            deliver(a, &mut |w| emit::emit_to(&ir, f, &a.options, w), &what)?;
         }
         Output::Kb => {
             let text = match db::JobWorld::of(&job.db, job.job()) {
@@ -240,13 +241,26 @@ pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
                     "`--emit kb` needs the PDDL problem: pass `--problem PROBLEM` or name it in the rules file"
                 ),
             };
-            std::mem::forget(job);
-            text
+            deliver(a, &mut |w| w.write_all(text.as_bytes()), &what)?;
         }
-    };
+    }
+    // The process ends here: freeing the IR piece by piece would take time
+    // the OS saves by reclaiming it at once.
+    std::mem::forget(ir);
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Writes a compiled output where `a` sends it: the file `-o` names
+/// (atomically, with the imported py_trees runtime beside it) or standard
+/// output; `what` is the summary said on standard error.
+fn deliver(
+    a: &CompileArgs,
+    produce: &mut btc_files::write::Produce<'_>,
+    what: &str,
+) -> anyhow::Result<()> {
     match &a.output {
         Some(out) => {
-            files::write_atomically(out, &text)?;
+            files::write_produced(out, produce)?;
             eprintln!("wrote {}: {what}", out.display());
             // An imported runtime goes beside the module, where its import
             // finds it; it is btc's file and always rewritten.
@@ -260,15 +274,16 @@ pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
             }
         }
         None => {
-            print!("{text}");
-            eprintln!("compiled {}: {what}", a.plan.display());
+            let mut stdout = std::io::stdout().lock();
+            match produce(&mut stdout).and_then(|()| stdout.flush()) {
+                Ok(()) => eprintln!("compiled {}: {what}", a.plan.display()),
+                // A reader that stopped early (`| head`) wanted no more.
+                Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {}
+                Err(e) => anyhow::bail!("cannot write to standard output: {e}"),
+            }
         }
     }
-    // The process ends here: freeing the IR and the output piece by piece
-    // would take time the OS saves by reclaiming them at once.
-    std::mem::forget(text);
-    std::mem::forget(ir);
-    Ok(ExitCode::SUCCESS)
+    Ok(())
 }
 
 /// `btc fmt [--check] FILES`: formats in place (atomically), or with

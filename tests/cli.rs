@@ -137,6 +137,61 @@ fn output_files_are_written_whole_or_not_at_all() {
     );
 }
 
+/// A long plan's tree is streamed: to a file and to standard output it is
+/// the same bytes, and a reader that stops early (`| head`) ends the
+/// compile quietly, not with a panic.
+#[test]
+fn a_long_plan_streams_to_a_file_and_to_a_reader_that_stops() {
+    let dir = tempfile::tempdir().unwrap();
+    for f in ["domain.pddl", "problem.pddl", "rules.btrules"] {
+        std::fs::copy(
+            Path::new("examples/p3_assembler").join(f),
+            dir.path().join(f),
+        )
+        .unwrap();
+    }
+    std::fs::write(
+        dir.path().join("plan.tplan"),
+        btc_testkit::long_p3_plan(20_000),
+    )
+    .unwrap();
+    let args = [
+        "compile",
+        "rules.btrules",
+        "--plan",
+        "plan.tplan",
+        "--emit",
+        "btcpp",
+        "--allow-invalid-plan",
+    ];
+    let to_stdout = support::btc_in(dir.path(), &args);
+    assert!(to_stdout.status.success());
+    assert!(
+        to_stdout.stdout.len() > 4 << 20,
+        "{} bytes",
+        to_stdout.stdout.len()
+    );
+    let to_file = support::btc_in(dir.path(), &[&args[..], &["-o", "tree.xml"]].concat());
+    assert!(to_file.status.success());
+    assert!(std::fs::read(dir.path().join("tree.xml")).unwrap() == to_stdout.stdout);
+
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_btc"))
+        .args(args)
+        .current_dir(dir.path())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut head = [0u8; 64];
+    std::io::Read::read_exact(child.stdout.as_mut().unwrap(), &mut head).unwrap();
+    assert!(head.starts_with(b"<?xml"));
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}
+
 /// The two example files of the design page (btrules v1, kept as
 /// `tests/fixtures/design/`) parse and check as written.
 #[test]

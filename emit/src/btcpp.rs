@@ -6,9 +6,11 @@
 //!
 //! `SubTree` elements get no `name` attribute: Groot2's monitor crashes on it.
 
+use crate::sink::{Sink, CHUNK};
 use crate::sizing::{steps_with_nodes, StepSizer, SAMPLE_STEPS};
 use btc_ir::*;
 use std::fmt::Write as _;
+use std::io;
 use std::sync::Arc;
 
 /// Whether a character must be escaped (or replaced) in an attribute value.
@@ -105,7 +107,7 @@ pub fn element_name(id: &str) -> std::borrow::Cow<'_, str> {
 /// An indenting XML writer straight into a `String`: elements are opened,
 /// given attributes one at a time and closed, with no per-element
 /// allocation (a 100,000-step plan writes a million elements).
-struct Xml {
+struct Xml<'w> {
     out: String,
     depth: usize,
     /// Where values are printed before they are escaped.
@@ -124,12 +126,15 @@ struct Xml {
     /// Steps' text after their number, by the addresses of their shared
     /// logic and child and the depth.
     step_tails: rustc_hash::FxHashMap<(usize, usize, usize), Box<str>>,
-    /// Sizes the buffer by the plan's first steps.
+    /// Sizes the buffer by the plan's first steps (when it is returned
+    /// whole).
     sizer: StepSizer,
+    /// Where the buffer goes at step boundaries.
+    sink: Sink<'w>,
 }
 
-impl Xml {
-    fn new(capacity: usize) -> Xml {
+impl<'w> Xml<'w> {
+    fn new(capacity: usize, sink: Sink<'w>) -> Xml<'w> {
         let mut out = String::with_capacity(capacity);
         out.push_str(r#"<?xml version="1.0" encoding="UTF-8"?>"#);
         Xml {
@@ -141,6 +146,7 @@ impl Xml {
             step_calls: Default::default(),
             step_tails: Default::default(),
             sizer: StepSizer::new(0),
+            sink,
         }
     }
 
@@ -152,14 +158,14 @@ impl Xml {
     }
 
     /// `<name` on a new line; attributes follow, then [`Xml::close`].
-    fn open(&mut self, name: &str) -> &mut Xml {
+    fn open(&mut self, name: &str) -> &mut Self {
         self.newline();
         self.out.push('<');
         self.out.push_str(name);
         self
     }
 
-    fn attr(&mut self, key: &str, value: &str) -> &mut Xml {
+    fn attr(&mut self, key: &str, value: &str) -> &mut Self {
         self.out.push(' ');
         self.out.push_str(key);
         self.out.push_str("=\"");
@@ -170,7 +176,7 @@ impl Xml {
 
     /// An attribute whose value is `value` printed (and escaped); empty
     /// for none.
-    fn attr_display(&mut self, key: &str, value: Option<&impl std::fmt::Display>) -> &mut Xml {
+    fn attr_display(&mut self, key: &str, value: Option<&impl std::fmt::Display>) -> &mut Self {
         self.scratch.clear();
         if let Some(v) = value {
             let _ = write!(self.scratch, "{v}");
@@ -184,7 +190,11 @@ impl Xml {
     }
 
     /// [`Xml::attr_display`] of a shared value, printed once per value.
-    fn attr_shared<T: std::fmt::Display>(&mut self, key: &str, value: Option<&Arc<T>>) -> &mut Xml {
+    fn attr_shared<T: std::fmt::Display>(
+        &mut self,
+        key: &str,
+        value: Option<&Arc<T>>,
+    ) -> &mut Self {
         let Some(v) = value else {
             return self.attr(key, "");
         };
@@ -206,7 +216,7 @@ impl Xml {
 
     /// An attribute whose value is written by `f` (unescaped: only for
     /// numbers and already-safe text).
-    fn attr_with(&mut self, key: &str, f: impl FnOnce(&mut String)) -> &mut Xml {
+    fn attr_with(&mut self, key: &str, f: impl FnOnce(&mut String)) -> &mut Self {
         self.out.push(' ');
         self.out.push_str(key);
         self.out.push_str("=\"");
@@ -218,7 +228,7 @@ impl Xml {
     /// A node's `name`: BT.CPP has no interpolation in names, so a part
     /// that a call fills in is written `?param`, the subtree port that
     /// carries its value (inlined trees have every part filled).
-    fn name(&mut self, name: &Option<Label>) -> &mut Xml {
+    fn name(&mut self, name: &Option<Label>) -> &mut Self {
         if let Some(n) = name {
             self.attr_display("name", Some(n));
         }
@@ -226,14 +236,14 @@ impl Xml {
     }
 
     /// BT.CPP's pre- and post-condition attributes (`_skipIf="..."`).
-    fn scripts(&mut self, scripts: &NodeScripts) -> &mut Xml {
+    fn scripts(&mut self, scripts: &NodeScripts) -> &mut Self {
         for (attr, text) in scripts.given() {
             self.attr(attr, text);
         }
         self
     }
 
-    fn port(&mut self, p: &Port) -> &mut Xml {
+    fn port(&mut self, p: &Port) -> &mut Self {
         match &p.value {
             PortValue::Text(s) => self.attr(&p.name, s),
             PortValue::Param(s) => {
@@ -375,7 +385,9 @@ fn node(x: &mut Xml, n: &Node, ir: &TreeIr) {
                         x.out.push_str(text);
                     } else {
                         let start = x.out.len();
+                        x.sink.hold();
                         step_tail(x, info, child, ir);
+                        x.sink.release();
                         let text = x.out[start..].into();
                         x.step_tails.insert(key, text);
                     }
@@ -384,6 +396,7 @@ fn node(x: &mut Xml, n: &Node, ir: &TreeIr) {
             }
             // Room after the steps for the rule trees and the models.
             x.sizer.written(&mut x.out, 65_536);
+            x.sink.step_done(&mut x.out);
         }
     }
 }
@@ -423,17 +436,33 @@ fn shared_node(x: &mut Xml, n: &Arc<Node>, ir: &TreeIr) {
         return;
     }
     let start = x.out.len();
+    x.sink.hold();
     node(x, n, ir);
+    x.sink.release();
     let text = x.out[start..].into();
     x.step_nodes.insert(key, text);
 }
 
 /// The XML document for a compiled plan.
 pub fn emit(ir: &TreeIr, inline: bool) -> String {
-    // Room for the first steps; the rest is sized as they are written.
-    let estimate = 4096 + ir.steps.len().min(SAMPLE_STEPS) * 512 + ir.trees.len() * 2048;
-    let mut x = Xml::new(estimate);
-    x.sizer = StepSizer::new(steps_with_nodes(ir));
+    emit_into(ir, inline, Sink::none()).expect("a buffer is written without errors")
+}
+
+/// [`emit`] streamed to `w` as it is produced.
+pub fn emit_to(ir: &TreeIr, inline: bool, w: &mut dyn io::Write) -> io::Result<()> {
+    emit_into(ir, inline, Sink::to(w)).map(drop)
+}
+
+fn emit_into(ir: &TreeIr, inline: bool, sink: Sink<'_>) -> io::Result<String> {
+    let mut x = if sink.streams() {
+        Xml::new(CHUNK + 65_536, sink)
+    } else {
+        // Room for the first steps; the rest is sized as they are written.
+        let estimate = 4096 + ir.steps.len().min(SAMPLE_STEPS) * 512 + ir.trees.len() * 2048;
+        let mut x = Xml::new(estimate, sink);
+        x.sizer = StepSizer::new(steps_with_nodes(ir));
+        x
+    };
     x.open("root")
         .attr("BTCPP_format", "4")
         .attr("main_tree_to_execute", &ir.main_tree)
@@ -524,7 +553,7 @@ pub fn emit(ir: &TreeIr, inline: bool) -> String {
     x.end("TreeNodesModel");
     x.end("root");
     x.out.push('\n');
-    x.out
+    x.sink.finish(x.out)
 }
 
 #[cfg(test)]

@@ -8,9 +8,11 @@ pub mod dot;
 pub mod executor;
 pub mod kb;
 pub mod pytrees;
+mod sink;
 mod sizing;
 
 use btc_ir::TreeIr;
+use std::io::Write as _;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Format {
@@ -93,19 +95,46 @@ pub struct Options {
     pub runtime: pytrees::Runtime,
 }
 
+impl Options {
+    fn pytrees(&self) -> pytrees::PyOptions<'_> {
+        pytrees::PyOptions {
+            runtime: self.runtime,
+            node_module: self.node_module.as_deref(),
+        }
+    }
+}
+
 pub fn emit(ir: &TreeIr, format: Format, options: &Options) -> String {
     match format {
         Format::Btcpp => btcpp::emit(ir, options.inline),
-        Format::Pytrees => pytrees::emit(
-            ir,
-            &pytrees::PyOptions {
-                runtime: options.runtime,
-                node_module: options.node_module.as_deref(),
-            },
-        ),
+        Format::Pytrees => pytrees::emit(ir, &options.pytrees()),
         Format::Json => json(ir),
         Format::Dot => dot::emit_dot(ir),
         Format::Mermaid => dot::emit_mermaid(ir),
         Format::Commands => commands::emit(ir),
+    }
+}
+
+/// [`emit`] written to `w`: the text a long plan makes most of (the
+/// steps of BT.CPP XML and py_trees, all of JSON) is streamed as it is
+/// produced, never whole in memory; the bytes are [`emit`]'s.
+pub fn emit_to(
+    ir: &TreeIr,
+    format: Format,
+    options: &Options,
+    w: &mut dyn std::io::Write,
+) -> std::io::Result<()> {
+    match format {
+        Format::Btcpp => btcpp::emit_to(ir, options.inline, w),
+        Format::Pytrees => pytrees::emit_to(ir, &options.pytrees(), w),
+        Format::Json => {
+            let mut w = std::io::BufWriter::with_capacity(sink::CHUNK, w);
+            serde_json::to_writer_pretty(&mut w, ir)?;
+            w.write_all(b"\n")?;
+            w.flush()
+        }
+        Format::Dot | Format::Mermaid | Format::Commands => {
+            w.write_all(emit(ir, format, options).as_bytes())
+        }
     }
 }

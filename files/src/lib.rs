@@ -14,4 +14,4 @@ pub mod read;
 pub mod write;
 
 pub use read::{read, ReadError};
-pub use write::{write, Stream};
+pub use write::{write, write_with, Stream};

@@ -61,25 +61,36 @@ fn plan(target: &Path) -> io::Result<Plan> {
 
 /// Writes `bytes` to `path` (see the module's documentation for how).
 pub fn write(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    write_with(path, &mut |w| w.write_all(bytes))
+}
+
+/// What writes an output's bytes to the file [`write_with`] opened: called
+/// once, or once more when the atomic way was refused before any byte.
+pub type Produce<'a> = dyn FnMut(&mut dyn Write) -> io::Result<()> + 'a;
+
+/// [`write`] of the bytes `produce` writes as it makes them (a long
+/// output need never be whole in memory). If it fails, a file replaced
+/// atomically is left as it was.
+pub fn write_with(path: &Path, produce: &mut Produce<'_>) -> io::Result<()> {
     let target = resolve(path)?;
     match plan(&target)? {
-        Plan::InPlace { truncate } => in_place(&target, bytes, truncate),
-        Plan::Atomic(old) => match atomic(&target, bytes, old)? {
+        Plan::InPlace { truncate } => in_place(&target, produce, truncate),
+        Plan::Atomic(old) => match atomic(&target, produce, old)? {
             Done::Written => Ok(()),
             // The folder is read-only (or the owner cannot be kept), but
             // the file itself may well be writable.
-            Done::Refused(e) if old.is_some() => in_place(&target, bytes, true).map_err(|_| e),
+            Done::Refused(e) if old.is_some() => in_place(&target, produce, true).map_err(|_| e),
             Done::Refused(e) => Err(e),
         },
     }
 }
 
-fn in_place(target: &Path, bytes: &[u8], truncate: bool) -> io::Result<()> {
+fn in_place(target: &Path, produce: &mut Produce<'_>, truncate: bool) -> io::Result<()> {
     let mut f = OpenOptions::new()
         .write(true)
         .truncate(truncate)
         .open(target)?;
-    f.write_all(bytes)?;
+    produce(&mut f)?;
     f.flush()?;
     if truncate {
         // Regular files only: syncing a pipe or a terminal is an error.
@@ -107,7 +118,11 @@ fn temp_path(target: &Path, attempt: u32) -> PathBuf {
     }
 }
 
-fn atomic(target: &Path, bytes: &[u8], old: Option<(u32, u32, u32)>) -> io::Result<Done> {
+fn atomic(
+    target: &Path,
+    produce: &mut Produce<'_>,
+    old: Option<(u32, u32, u32)>,
+) -> io::Result<Done> {
     let (guard, mut file) = {
         let mut attempt = 0;
         loop {
@@ -149,7 +164,7 @@ fn atomic(target: &Path, bytes: &[u8], old: Option<(u32, u32, u32)>) -> io::Resu
         }
         file.set_permissions(std::fs::Permissions::from_mode(mode))?;
     }
-    file.write_all(bytes)?;
+    produce(&mut file)?;
     file.sync_all()?;
     drop(file);
     std::fs::rename(guard.path(), target)?;

@@ -1,7 +1,7 @@
 //! The writer keeps what a rename would destroy: modes, owners, links,
 //! special files; and it is atomic for regular files.
 
-use btc_files::{write, Stream};
+use btc_files::{write, write_with, Stream};
 use std::os::unix::fs::{MetadataExt, PermissionsExt};
 use std::path::Path;
 use std::process::Command;
@@ -31,6 +31,37 @@ fn a_new_file_gets_the_umask_mode() {
     write(&p, b"<root/>").unwrap();
     assert_eq!(std::fs::read(&p).unwrap(), b"<root/>");
     assert_eq!(mode(&p), 0o666 & !umask());
+    assert!(leftovers(dir.path()).is_empty());
+}
+
+/// An output written piece by piece as it is made lands whole.
+#[test]
+fn a_produced_output_lands_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("out.xml");
+    write_with(&p, &mut |w| {
+        (0..1000).try_for_each(|i| writeln!(w, "<step n=\"{i}\"/>"))
+    })
+    .unwrap();
+    let expected: String = (0..1000).map(|i| format!("<step n=\"{i}\"/>\n")).collect();
+    assert_eq!(std::fs::read_to_string(&p).unwrap(), expected);
+    assert!(leftovers(dir.path()).is_empty());
+}
+
+/// A producer that fails half-way (a full disk, a broken emitter) leaves
+/// the old file as it was, and no temporary file beside it.
+#[test]
+fn a_failed_output_leaves_the_old_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("out.xml");
+    std::fs::write(&p, b"old").unwrap();
+    let err = write_with(&p, &mut |w| {
+        w.write_all(b"half of the new")?;
+        Err(std::io::Error::other("disk full"))
+    })
+    .unwrap_err();
+    assert_eq!(err.to_string(), "disk full");
+    assert_eq!(std::fs::read(&p).unwrap(), b"old");
     assert!(leftovers(dir.path()).is_empty());
 }
 

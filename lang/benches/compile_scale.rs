@@ -3,14 +3,16 @@
 //!
 //! A 100,000-step timed plan of the P3 shape (`btc_testkit::long_p3_plan`)
 //! is compiled from texts (parse, check, lower, emit) to a py_trees module
-//! (runtime imported), to BT.CPP XML and to JSON. The peer is
+//! (runtime imported), to BT.CPP XML and to JSON, as `btc compile -o`
+//! does it: the database is freed before the emit, and the output is
+//! streamed (here to a writer that counts its bytes). The peer is
 //! `benches/peers/p3_seed_generator.py`, the P3 seed's algorithm written
 //! anew in Python, timed as a whole process on the same plan. Printed per
 //! format: median time of 11 (the peer's of 5) and the speed-up over the
 //! peer, peak heap during the compile next to the output's size, bytes per
 //! step next to the peer's; each with its target.
 
-use btc_emit::{emit, pytrees::Runtime, Format, Options};
+use btc_emit::{emit_to, pytrees::Runtime, Format, Options};
 use btc_lang::db::{compile, CompileJob, Database};
 use std::alloc::{GlobalAlloc, Layout};
 use std::path::Path;
@@ -65,9 +67,23 @@ fn median(mut v: Vec<Duration>) -> Duration {
     v[v.len() / 2]
 }
 
-/// One compile from texts to `format`: its output, the peak heap above
-/// what was live before it, and the time the emitter took of it.
-fn compile_once(plan: &str, format: Format) -> (String, usize, Duration) {
+/// A writer that keeps only the number of bytes written to it.
+struct Count(usize);
+
+impl std::io::Write for Count {
+    fn write(&mut self, b: &[u8]) -> std::io::Result<usize> {
+        self.0 += b.len();
+        Ok(b.len())
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+/// One compile from texts to `format`, streamed as `btc compile -o`
+/// streams it (here to a writer that counts): the output's size, the peak
+/// heap above what was live before it, and the time the emitter took.
+fn compile_once(plan: &str, format: Format) -> (usize, usize, Duration) {
     let base = LIVE.load(Ordering::Relaxed);
     PEAK.store(base, Ordering::Relaxed);
     let mut db = Database::new();
@@ -88,9 +104,10 @@ fn compile_once(plan: &str, format: Format) -> (String, usize, Duration) {
         ..Options::default()
     };
     let t = Instant::now();
-    let text = emit(&ir, format, &options);
+    let mut out = Count(0);
+    emit_to(&ir, format, &options, &mut out).expect("counting never fails");
     let emitting = t.elapsed();
-    (text, PEAK.load(Ordering::Relaxed) - base, emitting)
+    (out.0, PEAK.load(Ordering::Relaxed) - base, emitting)
 }
 
 /// The peer on the same plan, whole process: median time and bytes written.
@@ -146,16 +163,16 @@ fn main() {
     ] {
         let mut times = Vec::new();
         let mut emit_times = Vec::new();
-        let mut out = (String::new(), 0);
+        let mut out = (0, 0);
         for _ in 0..BTC_RUNS {
             let t = Instant::now();
-            let (text, peak, emitting) = compile_once(&plan, format);
+            let (len, peak, emitting) = compile_once(&plan, format);
             times.push(t.elapsed());
             emit_times.push(emitting);
-            out = (text, peak);
+            out = (len, peak);
         }
         let t = median(times);
-        let (text, peak) = out;
+        let (len, peak) = out;
         let mut line = format!(
             "{:8}: {:.0} ms (emitting {:.0} ms of it)",
             format.name(),
@@ -171,14 +188,14 @@ fn main() {
         line += &format!(
             "; peak heap {:.0} MB for {:.1} MB out = {:.2}x (target <= 2x)",
             mb(peak),
-            mb(text.len()),
-            peak as f64 / text.len() as f64
+            mb(len),
+            peak as f64 / len as f64
         );
         if let (Some((_, pb)), Format::Pytrees) = (peer, format) {
             line += &format!(
                 "; {:.0} bytes/step = {:.2}x the peer's (target <= 1.2x)",
-                text.len() as f64 / STEPS as f64,
-                text.len() as f64 / pb as f64
+                len as f64 / STEPS as f64,
+                len as f64 / pb as f64
             );
         }
         println!("{line}");

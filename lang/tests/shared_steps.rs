@@ -2,9 +2,10 @@
 //! the IR, and the emitters write a shared value once and copy it. The
 //! output must not depend on that: each emitter writes the same text for
 //! the compiled IR as for a copy of it in which nothing is shared (the IR
-//! read back from its JSON, where every step has its own values).
+//! read back from its JSON, where every step has its own values). Nor
+//! on streaming: each emitter streams the bytes it returns whole.
 
-use btc_emit::{emit, pytrees::Runtime, Format, Options};
+use btc_emit::{emit, emit_to, pytrees::Runtime, Format, Options};
 use btc_ir::TreeIr;
 use btc_lang::db::{compile, CompileJob, Database};
 use std::path::Path;
@@ -58,11 +59,58 @@ fn same_output(what: &str, ir: &TreeIr) {
                 runtime: Runtime::Import,
                 ..Options::default()
             };
+            let whole = emit(ir, format, &options);
             assert!(
-                emit(ir, format, &options) == emit(&copy, format, &options),
+                whole == emit(&copy, format, &options),
                 "{what}: {} (inline: {inline}) writes a shared step differently",
                 format.name()
             );
+            assert_streams_as_whole(what, ir, format, &options, &whole);
+        }
+    }
+}
+
+fn assert_streams_as_whole(
+    what: &str,
+    ir: &TreeIr,
+    format: Format,
+    options: &Options,
+    whole: &str,
+) {
+    let mut streamed = Vec::new();
+    emit_to(ir, format, options, &mut streamed).expect("a Vec takes every write");
+    assert!(
+        streamed == whole.as_bytes(),
+        "{what}: {} (inline: {}) streams other bytes than it returns",
+        format.name(),
+        options.inline
+    );
+}
+
+/// A plan long enough that its outputs stream in several chunks.
+#[test]
+fn a_long_plan_streams_the_bytes_it_returns() {
+    let ir = compiled(
+        "examples/p3_assembler",
+        "rules.btrules",
+        "problem.pddl",
+        btc_testkit::long_p3_plan(20_000),
+    );
+    for format in [Format::Btcpp, Format::Pytrees, Format::Json] {
+        for (inline, runtime) in [(false, Runtime::Import), (true, Runtime::Inline)] {
+            let options = Options {
+                inline,
+                runtime,
+                ..Options::default()
+            };
+            let whole = emit(&ir, format, &options);
+            assert!(
+                whole.len() > 3 << 20,
+                "{}: {} bytes",
+                format.name(),
+                whole.len()
+            );
+            assert_streams_as_whole("P3, 20,000 steps", &ir, format, &options, &whole);
         }
     }
 }

@@ -17,6 +17,7 @@
 mod encode;
 pub mod names;
 
+use crate::sink::{Sink, CHUNK};
 use crate::sizing::{steps_with_nodes, StepSizer, SAMPLE_STEPS};
 use btc_ir::vocab::{NodeSpec, PyTrees};
 use btc_ir::Count;
@@ -91,7 +92,7 @@ struct LeafClass {
     index: usize,
 }
 
-struct Emitter<'a> {
+struct Emitter<'a, 'w> {
     ir: &'a TreeIr,
     out: String,
     classes: HashMap<&'a str, LeafClass>,
@@ -101,16 +102,36 @@ struct Emitter<'a> {
     /// share it, and it is written once. (The IR is borrowed for the whole
     /// emit, so an address names one value.)
     step_nodes: std::cell::RefCell<rustc_hash::FxHashMap<(usize, usize), Box<str>>>,
-    /// Sizes the buffer by the main tree's first steps.
+    /// Sizes the buffer by the main tree's first steps (when it is
+    /// returned whole).
     root_sizer: std::cell::RefCell<StepSizer>,
+    /// Where the buffer goes at step boundaries.
+    sink: std::cell::RefCell<Sink<'w>>,
 }
 
 pub fn emit(ir: &TreeIr, options: &PyOptions<'_>) -> String {
+    emit_into(ir, options, Sink::none()).expect("a buffer is written without errors")
+}
+
+/// [`emit`] streamed to `w` as it is produced.
+pub fn emit_to(
+    ir: &TreeIr,
+    options: &PyOptions<'_>,
+    w: &mut dyn std::io::Write,
+) -> std::io::Result<()> {
+    emit_into(ir, options, Sink::to(w)).map(drop)
+}
+
+fn emit_into(ir: &TreeIr, options: &PyOptions<'_>, sink: Sink<'_>) -> std::io::Result<String> {
+    let streams = sink.streams();
     let mut e = Emitter {
         ir,
-        // Room for the first steps: the rows and the main tree are sized
-        // by them as they are written.
-        out: String::with_capacity(256 * ir.steps.len().min(SAMPLE_STEPS) + 16_384),
+        // Streamed: room for a chunk. Whole: room for the first steps; the
+        // rows and the main tree are sized by them as they are written.
+        out: String::with_capacity(match streams {
+            true => CHUNK + 65_536,
+            false => 256 * ir.steps.len().min(SAMPLE_STEPS) + 16_384,
+        }),
         classes: HashMap::new(),
         trees: ir
             .trees
@@ -119,7 +140,11 @@ pub fn emit(ir: &TreeIr, options: &PyOptions<'_>) -> String {
             .map(|(i, t)| (t.id.as_str(), i))
             .collect(),
         step_nodes: Default::default(),
-        root_sizer: std::cell::RefCell::new(StepSizer::new(steps_with_nodes(ir))),
+        root_sizer: std::cell::RefCell::new(StepSizer::new(match streams {
+            true => 0,
+            false => steps_with_nodes(ir),
+        })),
+        sink: std::cell::RefCell::new(sink),
     };
     e.header(options);
     e.world();
@@ -128,10 +153,10 @@ pub fn emit(ir: &TreeIr, options: &PyOptions<'_>) -> String {
     e.leaf_classes(&models, options.node_module);
     e.tree();
     e.footer();
-    e.out
+    e.sink.into_inner().finish(e.out)
 }
 
-impl<'a> Emitter<'a> {
+impl<'a> Emitter<'a, '_> {
     fn header(&mut self, options: &PyOptions<'_>) {
         let ir = self.ir;
         let o = &mut self.out;
@@ -331,7 +356,10 @@ impl<'a> Emitter<'a> {
             o.push_str(",\n");
         }
         o.push_str(")\n\nSTEPS = (\n");
-        let mut rows = StepSizer::new(self.ir.steps.len());
+        let mut rows = StepSizer::new(match self.sink.get_mut().streams() {
+            true => 0,
+            false => self.ir.steps.len(),
+        });
         // Each shared argument tuple as text, by its address.
         let mut tuples: rustc_hash::FxHashMap<usize, Box<str>> = Default::default();
         for (s, k) in self.ir.steps.iter().zip(of_step) {
@@ -342,6 +370,7 @@ impl<'a> Emitter<'a> {
             row_of(s, k, args, o);
             // Room after the rows for the leaf classes and the rule trees.
             rows.written(o, 65_536);
+            self.sink.get_mut().step_done(o);
         }
         o.push_str(")\n\nPLAN = Plan(SHAPES, STEPS)\n");
     }
@@ -510,6 +539,7 @@ impl<'a> Emitter<'a> {
                 o.push(')');
                 // Room after the steps for the module's end.
                 self.root_sizer.borrow_mut().written(o, 4096);
+                self.sink.borrow_mut().step_done(o);
             }
             Node::SubTree { id, ports, .. } => match self.trees.get(id.as_str()) {
                 Some(&t) => {
@@ -546,7 +576,9 @@ impl<'a> Emitter<'a> {
             return o.push_str(text);
         }
         let start = o.len();
+        self.sink.borrow_mut().hold();
         self.node(n, o, indent);
+        self.sink.borrow_mut().release();
         self.step_nodes.borrow_mut().insert(key, o[start..].into());
     }
 

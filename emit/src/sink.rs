@@ -1,0 +1,142 @@
+//! Streaming an emitter's text to a writer as it is produced.
+//!
+//! A long plan's output is tens of megabytes (a hundred for JSON). Built
+//! whole, it doubles what a compile holds and its fresh pages cost more
+//! than writing it; streamed, the emitter's buffer is handed to the writer
+//! in chunks at step boundaries and reused.
+
+use std::io::{self, Write};
+
+/// About how much text is handed to the writer at once.
+pub(crate) const CHUNK: usize = 1 << 20;
+
+/// Where an emitter's buffer goes at step boundaries: nowhere (the text
+/// is returned whole) or to a writer.
+pub(crate) struct Sink<'w> {
+    to: Option<&'w mut dyn Write>,
+    /// The first write error; later chunks are dropped, and the emit
+    /// returns it.
+    error: Option<io::Error>,
+    /// Captures in progress (a shared node's text being recorded from its
+    /// start in the buffer): the buffer is not handed over under one.
+    held: usize,
+}
+
+impl<'w> Sink<'w> {
+    /// The text stays in the buffer, returned whole.
+    pub fn none() -> Sink<'w> {
+        Sink {
+            to: None,
+            error: None,
+            held: 0,
+        }
+    }
+
+    pub fn to(w: &'w mut dyn Write) -> Sink<'w> {
+        Sink {
+            to: Some(w),
+            error: None,
+            held: 0,
+        }
+    }
+
+    pub fn streams(&self) -> bool {
+        self.to.is_some()
+    }
+
+    /// A capture of the buffer starts: no hand-over until it ends.
+    pub fn hold(&mut self) {
+        self.held += 1;
+    }
+
+    pub fn release(&mut self) {
+        self.held -= 1;
+    }
+
+    /// At a step boundary: hands the buffer over once it holds a chunk.
+    pub fn step_done(&mut self, out: &mut String) {
+        if self.held == 0 && out.len() >= CHUNK {
+            self.hand_over(out);
+        }
+    }
+
+    fn hand_over(&mut self, out: &mut String) {
+        if let Some(w) = self.to.as_mut() {
+            if self.error.is_none() {
+                if let Err(e) = w.write_all(out.as_bytes()) {
+                    self.error = Some(e);
+                }
+            }
+            out.clear();
+        }
+    }
+
+    /// The end of the emit: a streaming sink writes the rest and returns
+    /// an empty text (or the first error); otherwise the text is returned.
+    pub fn finish(mut self, mut out: String) -> io::Result<String> {
+        self.hand_over(&mut out);
+        match self.error {
+            Some(e) => Err(e),
+            None => Ok(out),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Streamed text arrives whole and in order, in chunks of about
+    /// [`CHUNK`]; none is handed over under a hold.
+    #[test]
+    fn chunks_arrive_in_order_and_not_under_a_hold() {
+        let mut got = Vec::new();
+        let mut sink = Sink::to(&mut got);
+        let mut out = String::new();
+        let mut expected = String::new();
+        for i in 0..200_000 {
+            let line = format!("step {i}\n");
+            out.push_str(&line);
+            expected.push_str(&line);
+            if i == 150_000 {
+                sink.hold();
+            }
+            sink.step_done(&mut out);
+            assert!(out.len() < CHUNK + 64 || i >= 150_000);
+        }
+        assert!(out.len() > CHUNK, "held text stays in the buffer");
+        sink.release();
+        assert_eq!(sink.finish(out).unwrap(), "");
+        assert_eq!(String::from_utf8(got).unwrap(), expected);
+    }
+
+    /// Without a writer the text is returned whole.
+    #[test]
+    fn without_a_writer_the_text_is_returned() {
+        let mut sink = Sink::none();
+        let mut out = "x".repeat(CHUNK + 1);
+        sink.step_done(&mut out);
+        assert_eq!(sink.finish(out).unwrap().len(), CHUNK + 1);
+    }
+
+    /// A failing writer's error is returned, not lost.
+    #[test]
+    fn a_write_error_is_returned() {
+        struct Full;
+        impl Write for Full {
+            fn write(&mut self, _: &[u8]) -> io::Result<usize> {
+                Err(io::Error::other("disk full"))
+            }
+            fn flush(&mut self) -> io::Result<()> {
+                Ok(())
+            }
+        }
+        let mut w = Full;
+        let mut sink = Sink::to(&mut w);
+        let mut out = "x".repeat(CHUNK);
+        sink.step_done(&mut out);
+        assert!(out.is_empty());
+        let err = sink.finish("rest".into()).unwrap_err();
+        assert_eq!(err.to_string(), "disk full");
+    }
+}
