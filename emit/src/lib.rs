@@ -66,22 +66,27 @@ impl Format {
 /// doubling instead, a long plan's buffer ends up to twice the text's size
 /// (256 MB for 136 MB of JSON), and its pages are touched by the copies.
 fn json(ir: &TreeIr) -> String {
-    struct Count(usize);
-    impl std::io::Write for Count {
-        fn write(&mut self, b: &[u8]) -> std::io::Result<usize> {
-            self.0 += b.len();
-            Ok(b.len())
-        }
-        fn flush(&mut self) -> std::io::Result<()> {
-            Ok(())
-        }
-    }
-    let mut count = Count(0);
+    let mut count = ByteCount(0);
     serde_json::to_writer_pretty(&mut count, ir).expect("the IR serializes");
     let mut out = Vec::with_capacity(count.0 + 1);
     serde_json::to_writer_pretty(&mut out, ir).expect("the IR serializes");
     out.push(b'\n');
     String::from_utf8(out).expect("serde_json writes UTF-8")
+}
+
+/// A writer that keeps only how many bytes were written to it: an
+/// output's size without its text.
+#[derive(Debug, Default)]
+pub struct ByteCount(pub usize);
+
+impl std::io::Write for ByteCount {
+    fn write(&mut self, b: &[u8]) -> std::io::Result<usize> {
+        self.0 += b.len();
+        Ok(b.len())
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
 }
 
 #[derive(Clone, Debug, Default)]

@@ -12,7 +12,7 @@
 //! peer, peak heap during the compile next to the output's size, bytes per
 //! step next to the peer's; each with its target.
 
-use btc_emit::{emit_to, pytrees::Runtime, Format, Options};
+use btc_emit::{emit_to, pytrees::Runtime, ByteCount, Format, Options};
 use btc_lang::db::{compile, CompileJob, Database};
 use std::alloc::{GlobalAlloc, Layout};
 use std::path::Path;
@@ -67,19 +67,6 @@ fn median(mut v: Vec<Duration>) -> Duration {
     v[v.len() / 2]
 }
 
-/// A writer that keeps only the number of bytes written to it.
-struct Count(usize);
-
-impl std::io::Write for Count {
-    fn write(&mut self, b: &[u8]) -> std::io::Result<usize> {
-        self.0 += b.len();
-        Ok(b.len())
-    }
-    fn flush(&mut self) -> std::io::Result<()> {
-        Ok(())
-    }
-}
-
 /// One compile from texts to `format`, streamed as `btc compile -o`
 /// streams it (here to a writer that counts): the output's size, the peak
 /// heap above what was live before it, and the time the emitter took.
@@ -104,7 +91,7 @@ fn compile_once(plan: &str, format: Format) -> (usize, usize, Duration) {
         ..Options::default()
     };
     let t = Instant::now();
-    let mut out = Count(0);
+    let mut out = ByteCount(0);
     emit_to(&ir, format, &options, &mut out).expect("counting never fails");
     let emitting = t.elapsed();
     (out.0, PEAK.load(Ordering::Relaxed) - base, emitting)
