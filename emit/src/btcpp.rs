@@ -6,7 +6,7 @@
 //!
 //! `SubTree` elements get no `name` attribute: Groot2's monitor crashes on it.
 
-use crate::sink::{Sink, CHUNK};
+use crate::sink::Sink;
 use crate::sizing::{steps_with_nodes, StepSizer, SAMPLE_STEPS};
 use btc_ir::*;
 use std::fmt::Write as _;
@@ -454,15 +454,11 @@ pub fn emit_to(ir: &TreeIr, inline: bool, w: &mut dyn io::Write) -> io::Result<(
 }
 
 fn emit_into(ir: &TreeIr, inline: bool, sink: Sink<'_>) -> io::Result<String> {
-    let mut x = if sink.streams() {
-        Xml::new(CHUNK + 65_536, sink)
-    } else {
-        // Room for the first steps; the rest is sized as they are written.
-        let estimate = 4096 + ir.steps.len().min(SAMPLE_STEPS) * 512 + ir.trees.len() * 2048;
-        let mut x = Xml::new(estimate, sink);
-        x.sizer = StepSizer::new(steps_with_nodes(ir));
-        x
-    };
+    // Room for the first steps; the rest is sized as they are written.
+    let estimate = 4096 + ir.steps.len().min(SAMPLE_STEPS) * 512 + ir.trees.len() * 2048;
+    let sizer = sink.sizer(steps_with_nodes(ir));
+    let mut x = Xml::new(sink.capacity(estimate), sink);
+    x.sizer = sizer;
     x.open("root")
         .attr("BTCPP_format", "4")
         .attr("main_tree_to_execute", &ir.main_tree)

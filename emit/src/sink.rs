@@ -5,6 +5,7 @@
 //! than writing it; streamed, the emitter's buffer is handed to the writer
 //! in chunks at step boundaries and reused.
 
+use crate::sizing::StepSizer;
 use std::io::{self, Write};
 
 /// About how much text is handed to the writer at once.
@@ -42,6 +43,21 @@ impl<'w> Sink<'w> {
 
     pub fn streams(&self) -> bool {
         self.to.is_some()
+    }
+
+    /// A buffer's first capacity: room for a chunk when streaming, else
+    /// `whole` (room for the first steps, the rest sized by them).
+    pub fn capacity(&self, whole: usize) -> usize {
+        match self.streams() {
+            true => CHUNK + 65_536,
+            false => whole,
+        }
+    }
+
+    /// A sizer for `steps` steps of text; one that never reserves when
+    /// streaming (the buffer holds a chunk, not the output).
+    pub fn sizer(&self, steps: usize) -> StepSizer {
+        StepSizer::new(if self.streams() { 0 } else { steps })
     }
 
     /// A capture of the buffer starts: no hand-over until it ends.

@@ -17,7 +17,7 @@
 mod encode;
 pub mod names;
 
-use crate::sink::{Sink, CHUNK};
+use crate::sink::Sink;
 use crate::sizing::{steps_with_nodes, StepSizer, SAMPLE_STEPS};
 use btc_ir::vocab::{NodeSpec, PyTrees};
 use btc_ir::Count;
@@ -123,15 +123,11 @@ pub fn emit_to(
 }
 
 fn emit_into(ir: &TreeIr, options: &PyOptions<'_>, sink: Sink<'_>) -> std::io::Result<String> {
-    let streams = sink.streams();
     let mut e = Emitter {
         ir,
-        // Streamed: room for a chunk. Whole: room for the first steps; the
-        // rows and the main tree are sized by them as they are written.
-        out: String::with_capacity(match streams {
-            true => CHUNK + 65_536,
-            false => 256 * ir.steps.len().min(SAMPLE_STEPS) + 16_384,
-        }),
+        // Room for the first steps: the rows and the main tree are sized
+        // by them as they are written.
+        out: String::with_capacity(sink.capacity(256 * ir.steps.len().min(SAMPLE_STEPS) + 16_384)),
         classes: HashMap::new(),
         trees: ir
             .trees
@@ -140,10 +136,7 @@ fn emit_into(ir: &TreeIr, options: &PyOptions<'_>, sink: Sink<'_>) -> std::io::R
             .map(|(i, t)| (t.id.as_str(), i))
             .collect(),
         step_nodes: Default::default(),
-        root_sizer: std::cell::RefCell::new(StepSizer::new(match streams {
-            true => 0,
-            false => steps_with_nodes(ir),
-        })),
+        root_sizer: std::cell::RefCell::new(sink.sizer(steps_with_nodes(ir))),
         sink: std::cell::RefCell::new(sink),
     };
     e.header(options);
@@ -356,10 +349,7 @@ impl<'a> Emitter<'a, '_> {
             o.push_str(",\n");
         }
         o.push_str(")\n\nSTEPS = (\n");
-        let mut rows = StepSizer::new(match self.sink.get_mut().streams() {
-            true => 0,
-            false => self.ir.steps.len(),
-        });
+        let mut rows = self.sink.get_mut().sizer(self.ir.steps.len());
         // Each shared argument tuple as text, by its address.
         let mut tuples: rustc_hash::FxHashMap<usize, Box<str>> = Default::default();
         for (s, k) in self.ir.steps.iter().zip(of_step) {
