@@ -11,7 +11,7 @@ impl<'w> Engine<'w> {
     /// child that ended the node is where the next tick starts
     /// (SequenceWithMemory). SKIPPED children are passed over; when all
     /// were, the node is SKIPPED.
-    #[inline]
+    #[inline(never)]
     pub(super) fn tick_ordered<const FALLBACK: bool, const REACTIVE: bool, const MEMORY: bool>(
         &mut self,
         iu: usize,
@@ -87,6 +87,7 @@ impl<'w> Engine<'w> {
         }
     }
 
+    #[inline(never)]
     pub(super) fn tick_parallel(
         &mut self,
         iu: usize,

@@ -8,6 +8,7 @@ use super::{Arg, Engine, NodeDef, Op, Status};
 
 impl<'w> Engine<'w> {
     /// The decorators that map their child's status.
+    #[inline(never)]
     pub(super) fn tick_wrapper(&mut self, i: u32, def: NodeDef) -> Status {
         // BT.CPP's SubTree becomes RUNNING only from IDLE: one ticked again
         // after it finished (WhileDoElse's condition) keeps its status.
@@ -36,6 +37,7 @@ impl<'w> Engine<'w> {
 
     /// Retry (`RETRY`) counts failures and stops at a success; Repeat
     /// counts successes and stops at a failure. `n < 0`: forever.
+    #[inline(never)]
     pub(super) fn tick_loop<const RETRY: bool>(
         &mut self,
         i: u32,
@@ -95,6 +97,7 @@ impl<'w> Engine<'w> {
         }
     }
 
+    #[inline(never)]
     pub(super) fn tick_timeout(&mut self, i: u32, def: NodeDef, arg: Arg<u64>) -> Status {
         let iu = i as usize;
         let c = self.kid(def, 0);

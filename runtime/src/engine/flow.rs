@@ -8,6 +8,7 @@ use super::{Arg, Engine, NodeDef, Status, Value};
 impl<'w> Engine<'w> {
     /// The condition (first child) picks the then (second) or the else
     /// (third) child once; that child then runs to completion.
+    #[inline(never)]
     pub(super) fn tick_if_then_else(&mut self, i: u32, def: NodeDef) -> Status {
         let iu = i as usize;
         self.set(iu, Status::Running);
@@ -44,6 +45,7 @@ impl<'w> Engine<'w> {
 
     /// The condition is ticked every tick; the branch it picks runs, and
     /// the other one is halted.
+    #[inline(never)]
     pub(super) fn tick_while_do_else(&mut self, i: u32, def: NodeDef) -> Status {
         self.set(i as usize, Status::Running);
         let cond = self.kid(def, 0);
@@ -78,6 +80,7 @@ impl<'w> Engine<'w> {
 
     /// The child of the first case equal to the variable (as strings, or
     /// as numbers), or the last child.
+    #[inline(never)]
     pub(super) fn tick_switch(
         &mut self,
         iu: usize,
@@ -114,6 +117,7 @@ impl<'w> Engine<'w> {
     }
 
     /// RUNNING for `msec` of simulated time, then the child's status.
+    #[inline(never)]
     pub(super) fn tick_delay(&mut self, i: u32, def: NodeDef, arg: Arg<u64>) -> Status {
         let iu = i as usize;
         let until = match self.state[iu] {
@@ -147,6 +151,7 @@ impl<'w> Engine<'w> {
     }
 
     /// The child runs once; afterwards SKIPPED, or its result again.
+    #[inline(never)]
     pub(super) fn tick_run_once(&mut self, iu: usize, def: NodeDef, then_skip: bool) -> Status {
         if let NodeState::Ran(s) = self.state[iu] {
             return if then_skip { Status::Skipped } else { s };
@@ -162,6 +167,7 @@ impl<'w> Engine<'w> {
     }
 
     /// The child runs when the script holds as it starts; else `otherwise`.
+    #[inline(never)]
     pub(super) fn tick_precondition(
         &mut self,
         i: u32,

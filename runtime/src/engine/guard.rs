@@ -95,6 +95,7 @@ impl<'w> Engine<'w> {
         }
     }
 
+    #[inline(never)]
     pub(super) fn tick_script(&mut self, i: u32, k: u32) -> Status {
         match self.run_script(i, k) {
             Some(_) => Status::Success,
@@ -102,6 +103,7 @@ impl<'w> Engine<'w> {
         }
     }
 
+    #[inline(never)]
     pub(super) fn tick_script_condition(&mut self, i: u32, k: u32) -> Status {
         match self.script_holds(i, k) {
             Some(true) => Status::Success,
@@ -116,6 +118,7 @@ impl<'w> Engine<'w> {
 
     /// A node with scripts around it, ticked as BT.CPP's `executeTick`.
     #[cold]
+    #[inline(never)]
     pub(super) fn tick_guarded(&mut self, i: u32, def: NodeDef) -> Status {
         let iu = i as usize;
         let g = self.guards[def.guard as usize];

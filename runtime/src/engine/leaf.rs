@@ -10,6 +10,7 @@ use crate::controller::Command;
 use crate::kb::{EffectId, FormulaId};
 
 impl<'w> Engine<'w> {
+    #[inline(never)]
     pub(super) fn tick_sleep(&mut self, iu: usize, port: u32) -> Status {
         if self.status[iu] != Status::Running {
             let ms = self.read(port).as_int().unwrap_or(0);
@@ -25,6 +26,7 @@ impl<'w> Engine<'w> {
         }
     }
 
+    #[inline(never)]
     pub(super) fn tick_set_blackboard(&mut self, value: u32, slot: u32) -> Status {
         let v = self.read(value).clone();
         if self.bb[slot as usize] != v {
@@ -34,6 +36,7 @@ impl<'w> Engine<'w> {
         Status::Success
     }
 
+    #[inline(never)]
     pub(super) fn tick_kb_holds(&mut self, i: u32, f: FormulaId) -> Status {
         if let Some(s) = self.blackout() {
             if s == Status::Failure {
@@ -66,6 +69,7 @@ impl<'w> Engine<'w> {
         }
     }
 
+    #[inline(never)]
     pub(super) fn tick_condition(&mut self, i: u32, c: u32) -> Status {
         let cu = c as usize;
         let Some(formula) = self.conds[cu].formula else {
@@ -118,6 +122,7 @@ impl<'w> Engine<'w> {
             .collect()
     }
 
+    #[inline(never)]
     pub(super) fn tick_action(&mut self, i: u32, a: u32) -> Status {
         if let Some(h) = self.actions[a as usize].handler {
             return self.tick_handled(i, a, h);

@@ -41,6 +41,7 @@ impl<'w> Engine<'w> {
     }
 
     /// Node `node` fails for a reason told in words.
+    #[cold]
     pub(super) fn fail(&mut self, node: u32, why: &str) -> Status {
         self.note_failure(node, Reason::Plain(why.to_owned()));
         Status::Failure

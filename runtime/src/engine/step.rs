@@ -34,6 +34,7 @@ impl StepRt {
 }
 
 impl<'w> Engine<'w> {
+    #[inline(never)]
     pub(super) fn tick_step(&mut self, i: u32, def: NodeDef, k: u32) -> Status {
         let iu = i as usize;
         let ku = k as usize;
