@@ -14,75 +14,72 @@ use btc_ir::vocab::{NodeName, NodeSpec};
 use btc_ir::{LeafKind, NodeModel, PortDirection, PortModel, PortValue};
 use btc_pddl::diagnostic::{codes, did_you_mean};
 use btc_pddl::logic::decode;
+use quick_xml::events::attributes::Attributes;
 use quick_xml::events::{BytesStart, Event};
 use quick_xml::Reader;
+use std::borrow::Cow;
 
 fn syntax(msg: impl Into<String>, at: usize) -> LoadError {
     LoadError::new(codes::X_TREE_SYNTAX, msg).at(at)
 }
 
-struct Elem {
-    name: String,
-    attrs: Vec<(String, String)>,
-    /// Where each attribute's name is, by name (kept when `attrs` is taken
-    /// apart): diagnostics about an attribute point at it.
-    attr_at: Vec<(String, usize)>,
+/// An element as read: its name and attributes are slices of the file's
+/// text (a value is owned only when it had entities to unescape), so
+/// reading an element allocates one vector, and only what the tree keeps
+/// is copied out of it.
+struct Elem<'a> {
+    name: &'a str,
+    attrs: Vec<Attr<'a>>,
     /// Where the element's `<` is.
     at: usize,
 }
 
-/// Where `part`, a slice of the element `e` (whose `<` is at `at`), is in
-/// the file. quick-xml gives attributes no positions, but a reader of a
-/// `&str` hands out slices of it, so the distance from the element's own
-/// bytes is the position; `at` when `part` is not such a slice.
-fn offset_in(e: &BytesStart, part: &[u8], at: usize) -> usize {
-    let base = e.as_ptr() as usize;
-    let p = part.as_ptr() as usize;
-    if p >= base && p + part.len() <= base + e.len() {
-        at + 1 + (p - base)
-    } else {
-        at
-    }
+struct Attr<'a> {
+    key: &'a str,
+    value: Cow<'a, str>,
+    /// Where the attribute's name is: diagnostics about it point there.
+    at: usize,
 }
 
-/// A name the reader sliced out of the `&str` it reads, so UTF-8 (the
-/// lossy decoder is the fallback, and walked every name byte by byte).
-fn text_of(bytes: &[u8]) -> String {
-    match std::str::from_utf8(bytes) {
-        Ok(s) => s.to_owned(),
-        Err(_) => String::from_utf8_lossy(bytes).into_owned(),
-    }
-}
-
-fn elem(e: &BytesStart, r: &Reader<&[u8]>, at: usize) -> Result<Elem, LoadError> {
-    let name = text_of(e.name().as_ref());
+/// The element `e` (whose `<` is at `at`) read from `text`, the string the
+/// reader reads. quick-xml's events borrow from that string but name it
+/// with their own shorter lifetime, so the element's bytes are found again
+/// in `text` (by address) and its attributes read from there.
+fn elem<'a>(text: &'a str, e: &BytesStart, at: usize) -> Result<Elem<'a>, LoadError> {
+    let content =
+        slice_in(text, e).ok_or_else(|| syntax("an element that is not in the file", at))?;
+    let name = &content[..e.name().as_ref().len()];
     let mut attrs = Vec::new();
-    let mut attr_at = Vec::new();
-    for a in e.attributes() {
+    for a in Attributes::new(content, name.len()) {
         let a = a.map_err(|err| syntax(format!("a bad attribute in <{name}>: {err}"), at))?;
-        let key = text_of(a.key.as_ref());
-        attr_at.push((key.clone(), offset_in(e, a.key.as_ref(), at)));
+        let key = slice_in(content, a.key.into_inner())
+            .ok_or_else(|| syntax(format!("a bad attribute name in <{name}>"), at))?;
+        let key_at = at + 1 + (key.as_ptr() as usize - content.as_ptr() as usize);
         let value = a
-            .decode_and_unescape_value(r.decoder())
-            .map_err(|err| syntax(format!("a bad attribute value in <{name}>: {err}"), at))?
-            .into_owned();
-        attrs.push((key, value));
+            .unescape_value()
+            .map_err(|err| syntax(format!("a bad attribute value in <{name}>: {err}"), at))?;
+        attrs.push(Attr {
+            key,
+            value,
+            at: key_at,
+        });
     }
-    Ok(Elem {
-        name,
-        attrs,
-        attr_at,
-        at,
-    })
+    Ok(Elem { name, attrs, at })
 }
 
-impl Elem {
+/// `part`, a slice of `text`'s bytes, as a slice of `text`.
+fn slice_in<'a>(text: &'a str, part: &[u8]) -> Option<&'a str> {
+    let start = (part.as_ptr() as usize).checked_sub(text.as_ptr() as usize)?;
+    text.get(start..start.checked_add(part.len())?)
+}
+
+impl<'a> Elem<'a> {
     /// Where attribute `k`'s name is (the element's `<` without it).
     fn attr_at(&self, k: &str) -> usize {
-        self.attr_at
+        self.attrs
             .iter()
-            .find(|(a, _)| a == k)
-            .map_or(self.at, |(_, at)| *at)
+            .find(|a| a.key == k)
+            .map_or(self.at, |a| a.at)
     }
 
     /// Where the element's tag name is.
@@ -93,8 +90,8 @@ impl Elem {
     fn get(&self, k: &str) -> Option<&str> {
         self.attrs
             .iter()
-            .find(|(a, _)| a == k)
-            .map(|(_, v)| v.as_str())
+            .find(|a| a.key == k)
+            .map(|a| a.value.as_ref())
     }
 
     fn int(&self, k: &str, default: Option<i64>) -> Result<i64, LoadError> {
@@ -168,23 +165,26 @@ fn port_value(v: String) -> PortValue {
     }
 }
 
-/// The attributes that are ports (all but `name` and `skip`), moved out.
-fn ports(e: &mut Elem, skip: &[&str]) -> Vec<(String, PortValue)> {
-    std::mem::take(&mut e.attrs)
-        .into_iter()
-        .filter(|(k, _)| k != "name" && !skip.contains(&k.as_str()))
-        .map(|(k, v)| (k, port_value(v)))
+/// The attributes that are ports: all but `name`, `skip` and the pre- and
+/// post-conditions.
+fn ports(e: &Elem, skip: &[&str]) -> Vec<(String, PortValue)> {
+    e.attrs
+        .iter()
+        .filter(|a| {
+            a.key != "name" && !skip.contains(&a.key) && !NodeScripts::ATTRIBUTES.contains(&a.key)
+        })
+        .map(|a| (a.key.to_owned(), port_value(a.value.clone().into_owned())))
         .collect()
 }
 
-/// The pre- and post-condition attributes (`_skipIf`...), moved out; any
-/// other attribute starting with `_` but `_autoremap` is refused (X041).
-fn node_scripts(e: &mut Elem) -> Result<NodeScripts, LoadError> {
+/// The pre- and post-condition attributes (`_skipIf`...); any other
+/// attribute starting with `_` but `_autoremap` is refused (X041).
+fn node_scripts(e: &Elem) -> Result<NodeScripts, LoadError> {
     let mut scripts = NodeScripts::default();
-    let mut rest = Vec::with_capacity(e.attrs.len());
-    for (k, v) in std::mem::take(&mut e.attrs) {
-        match NodeScripts::ATTRIBUTES.iter().position(|a| *a == k) {
-            Some(i) => *scripts.slot(i) = Some(v),
+    for a in &e.attrs {
+        let k = a.key;
+        match NodeScripts::ATTRIBUTES.iter().position(|s| *s == k) {
+            Some(i) => *scripts.slot(i) = Some(a.value.clone().into_owned()),
             None if k.starts_with('_') && k != "_autoremap" => {
                 let known = NodeScripts::ATTRIBUTES
                     .iter()
@@ -194,17 +194,16 @@ fn node_scripts(e: &mut Elem) -> Result<NodeScripts, LoadError> {
                     codes::X_UNSUPPORTED,
                     format!("<{}>: the attribute `{k}` is not one btc runs", e.name),
                 )
-                .at(e.attr_at(&k));
-                err = err.hint(match did_you_mean(&k, known) {
+                .at(a.at);
+                err = err.hint(match did_you_mean(k, known) {
                     Some(h) => h,
                     None => "btc runs the pre- and post-conditions `_failureIf`, `_successIf`, `_skipIf`, `_while`, `_onSuccess`, `_onFailure`, `_post` and `_onHalted`, and SubTree's `_autoremap`".into(),
                 });
                 return Err(err);
             }
-            None => rest.push((k, v)),
+            None => {}
         }
     }
-    e.attrs = rest;
     Ok(scripts)
 }
 
@@ -297,8 +296,8 @@ fn vocab_kind(spec: &NodeSpec, e: &Elem) -> Result<Kind, LoadError> {
     })
 }
 
-fn node_of(mut e: Elem) -> Result<SNode, LoadError> {
-    if NOT_RUN.contains(&e.name.as_str()) {
+fn node_of(e: Elem) -> Result<SNode, LoadError> {
+    if NOT_RUN.contains(&e.name) {
         return Err(LoadError::new(
             codes::X_UNSUPPORTED,
             format!(
@@ -310,11 +309,11 @@ fn node_of(mut e: Elem) -> Result<SNode, LoadError> {
         .hint("docs/runtime.md lists the nodes btc runs"));
     }
     let name = e.get("name").map(str::to_owned);
-    let scripts = node_scripts(&mut e)?;
-    let kind = if let Some(spec) = NodeSpec::by_tag(&e.name) {
+    let scripts = node_scripts(&e)?;
+    let kind = if let Some(spec) = NodeSpec::by_tag(e.name) {
         vocab_kind(spec, &e)?
     } else {
-        match e.name.as_str() {
+        match e.name {
             "SequenceWithMemory" | "SequenceStar" => Kind::SequenceWithMemory,
             "KeepRunningUntilFailure" => Kind::KeepRunningUntilFailure,
             "IfThenElse" => Kind::IfThenElse,
@@ -359,7 +358,7 @@ fn node_of(mut e: Elem) -> Result<SNode, LoadError> {
                 let autoremap = e.get("_autoremap").is_some_and(|v| v.trim() == "true");
                 Kind::SubTree {
                     id,
-                    ports: ports(&mut e, &["ID", "_autoremap"]),
+                    ports: ports(&e, &["ID", "_autoremap"]),
                     autoremap,
                 }
             }
@@ -401,14 +400,14 @@ fn node_of(mut e: Elem) -> Result<SNode, LoadError> {
                 Kind::Leaf {
                     id,
                     kind,
-                    ports: ports(&mut e, &["ID"]),
+                    ports: ports(&e, &["ID"]),
                 }
             }
             _ => {
-                let mut ps = ports(&mut e, &[]);
+                let mut ps = ports(&e, &[]);
                 kb_ports(&e, &mut ps)?;
                 Kind::Leaf {
-                    id: std::mem::take(&mut e.name),
+                    id: e.name.to_owned(),
                     kind: None,
                     ports: ps,
                 }
@@ -478,7 +477,7 @@ fn bad_pddl(e: &Elem, key: &str, text: &str, what: &str, why: &str) -> LoadError
 fn kb_ports(e: &Elem, ports: &mut [(String, PortValue)]) -> Result<(), LoadError> {
     for (k, v) in ports {
         let PortValue::Text(t) = v else { continue };
-        *v = match (e.name.as_str(), k.as_str()) {
+        *v = match (e.name, k.as_str()) {
             ("KbHolds", "formula") => PortValue::Formula(std::sync::Arc::new(
                 decode::formula(t).map_err(|m| bad_pddl(e, k, t, "a PDDL condition", &m))?,
             )),
@@ -518,7 +517,7 @@ fn model_of(e: &Elem, kind: LeafKind) -> Result<NodeModel, LoadError> {
 }
 
 fn port_model(e: &Elem) -> Option<PortModel> {
-    let direction = match e.name.as_str() {
+    let direction = match e.name {
         "input_port" | "inout_port" => PortDirection::Input,
         "output_port" => PortDirection::Output,
         _ => return None,
@@ -626,8 +625,8 @@ pub fn parse_file(text: &str) -> Result<Parsed, LoadError> {
         // Where the element's `<` is: the reader stands after its `>`.
         let end = r.buffer_position() as usize;
         let (start, empty) = match &ev {
-            Event::Start(e) => (Some(elem(e, &r, end.saturating_sub(e.len() + 2))?), false),
-            Event::Empty(e) => (Some(elem(e, &r, end.saturating_sub(e.len() + 3))?), true),
+            Event::Start(e) => (Some(elem(text, e, end.saturating_sub(e.len() + 2))?), false),
+            Event::Empty(e) => (Some(elem(text, e, end.saturating_sub(e.len() + 3))?), true),
             _ => (None, false),
         };
         let at = start.as_ref().map_or(at, |e| e.at);
@@ -655,7 +654,7 @@ pub fn parse_file(text: &str) -> Result<Parsed, LoadError> {
                         place = Place::Root;
                     }
                 }
-                Place::Root => match e.name.as_str() {
+                Place::Root => match e.name {
                     "BehaviorTree" => {
                         let id = e.get("ID").unwrap_or("MainTree").to_owned();
                         if !tree_ids.insert(id.clone()) {
@@ -727,7 +726,7 @@ pub fn parse_file(text: &str) -> Result<Parsed, LoadError> {
                     }
                 }
                 Place::Models => {
-                    let kind = match e.name.as_str() {
+                    let kind = match e.name {
                         "Action" => Some(LeafKind::Action),
                         "Condition" => Some(LeafKind::Condition),
                         _ => None,

@@ -647,7 +647,7 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
         &mut self,
         n: &SNode,
         ports: &[(String, PortValue)],
-        types: &dyn Fn(&str) -> Option<String>,
+        types: &dyn Fn(&str) -> Option<&'d str>,
         scope: &mut Scope,
     ) -> Result<(u32, u32), LoadError> {
         let start = self.e.ports.len() as u32;
@@ -660,7 +660,7 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
                 other => {
                     let val = Value::from_port(other);
                     let val = match types(k) {
-                        Some(ty) => val.typed(&ty).map_err(|m| {
+                        Some(ty) => val.typed(ty).map_err(|m| {
                             self.err(
                                 codes::X_BAD_PORT,
                                 n,
@@ -813,7 +813,7 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
             "Sleep" => {
                 self.const_text(n, ports, "msec", true)?;
                 let (a, _) =
-                    self.bind_ports(n, ports, &|k| (k == "msec").then(|| "int".into()), scope)?;
+                    self.bind_ports(n, ports, &|k| (k == "msec").then_some("int"), scope)?;
                 let p = ports.iter().position(|(k, _)| k == "msec").unwrap_or(0) as u32;
                 return Ok(Op::Sleep(a + p));
             }
@@ -892,8 +892,8 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
             });
             e
         })?;
-        let types = |k: &str| -> Option<String> {
-            model.and_then(|m| m.ports.iter().find(|p| p.name == k).map(|p| p.ty.clone()))
+        let types = |k: &str| -> Option<&'d str> {
+            model.and_then(|m| m.ports.iter().find(|p| p.name == k).map(|p| p.ty.as_str()))
         };
         let range = self.bind_ports(n, ports, &types, scope)?;
         Ok(match kind {
