@@ -140,6 +140,8 @@ pub struct Evaluator {
     marked: Vec<bool>,
     in_plan: Vec<bool>,
     stack: Vec<u32>,
+    /// The relaxed plan's operators (kept to reuse its allocation).
+    plan: Vec<u32>,
     /// Operators of the last relaxed plan that apply in the evaluated state.
     pub preferred: Vec<u32>,
 }
@@ -294,6 +296,7 @@ impl Evaluator {
             marked: vec![false; nf],
             in_plan: vec![false; task.operators.len()],
             stack: Vec::new(),
+            plan: Vec::new(),
             preferred: Vec::new(),
         }
     }
@@ -360,34 +363,44 @@ impl Evaluator {
                 }
             }
         }
-        // Costs are final when popped: stop once every goal fact is.
+        // Costs are final when popped: stop once every goal fact is. The
+        // tables are borrowed as slices first, so that their lengths stay
+        // in registers (through `self` they were reloaded on every access).
+        let (cost, supporter, unsat, acc, heap) = (
+            &mut self.cost[..],
+            &mut self.supporter[..],
+            &mut self.unsat[..],
+            &mut self.acc[..],
+            &mut self.heap,
+        );
+        let (ops, pre_of, is_goal) = (&self.ops[..], &self.pre_of[..], &self.is_goal[..]);
         let mut goals_left = self.goal.len();
-        while let Some((c, f)) = self.heap.pop() {
+        while let Some((c, f)) = heap.pop() {
             if goals_left == 0 {
                 break;
             }
-            if c > self.cost[f as usize] {
+            if c > cost[f as usize] {
                 continue;
             }
-            if self.is_goal[f as usize] {
+            if is_goal[f as usize] {
                 goals_left -= 1;
             }
-            for &ui in &self.pre_of[f as usize] {
+            for &ui in &pre_of[f as usize] {
                 let i = ui as usize;
-                self.unsat[i] -= 1;
-                self.acc[i] = if max {
-                    self.acc[i].max(c)
+                unsat[i] -= 1;
+                acc[i] = if max {
+                    acc[i].max(c)
                 } else {
-                    self.acc[i].saturating_add(c)
+                    acc[i].saturating_add(c)
                 };
-                if self.unsat[i] == 0 {
-                    let u = &self.ops[i];
-                    let nc = self.acc[i].saturating_add(u.cost);
+                if unsat[i] == 0 {
+                    let u = &ops[i];
+                    let nc = acc[i].saturating_add(u.cost);
                     for &e in &u.effs {
-                        if nc < self.cost[e as usize] {
-                            self.cost[e as usize] = nc;
-                            self.supporter[e as usize] = ui;
-                            self.heap.push(nc, e);
+                        if nc < cost[e as usize] {
+                            cost[e as usize] = nc;
+                            supporter[e as usize] = ui;
+                            heap.push(nc, e);
                         }
                     }
                 }
@@ -406,7 +419,8 @@ impl Evaluator {
         }
         // Relaxed plan from the best supporters.
         self.marked.iter_mut().for_each(|m| *m = false);
-        let mut plan: Vec<u32> = Vec::new();
+        let mut plan = std::mem::take(&mut self.plan);
+        plan.clear();
         self.stack.clear();
         self.stack.extend(self.goal.iter().copied());
         let mut hff = 0u64;
@@ -427,12 +441,13 @@ impl Evaluator {
             }
             self.stack.extend(u.pre.iter().copied());
         }
-        for o in plan {
+        for &o in &plan {
             self.in_plan[o as usize] = false;
             if holds(s, &task.operators[o as usize].pre) {
                 self.preferred.push(o);
             }
         }
+        self.plan = plan;
         Some(hff)
     }
 }
