@@ -153,7 +153,7 @@ impl NodeScripts {
     }
 
     pub fn is_empty(&self) -> bool {
-        *self.slots() == NO_SLOTS
+        self.slots.as_deref().is_none_or(|s| *s == NO_SLOTS)
     }
 
     fn slots(&self) -> &Slots {
