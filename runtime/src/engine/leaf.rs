@@ -69,7 +69,7 @@ impl<'w> Engine<'w> {
         }
     }
 
-    #[inline(never)]
+    #[inline]
     pub(super) fn tick_condition(&mut self, i: u32, c: u32) -> Status {
         let cu = c as usize;
         let Some(formula) = self.conds[cu].formula else {
@@ -122,7 +122,7 @@ impl<'w> Engine<'w> {
             .collect()
     }
 
-    #[inline(never)]
+    #[inline]
     pub(super) fn tick_action(&mut self, i: u32, a: u32) -> Status {
         if let Some(h) = self.actions[a as usize].handler {
             return self.tick_handled(i, a, h);

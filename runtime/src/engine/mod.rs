@@ -454,10 +454,12 @@ impl<'w> Engine<'w> {
     /// post-conditions, then the status is set (a SKIPPED node keeps its
     /// own, as in BT.CPP).
     ///
-    /// `tick_node` and `tick_op` are inlined into every family's loop, so
-    /// that ticking a simple leaf costs no call; the families are
-    /// `#[inline(never)]`, which ends the recursion there and keeps their
-    /// frames off a leaf's path (this halved the time per leaf tick).
+    /// `tick_node` and `tick_op` are inlined into every family's loop, and
+    /// with them the common leaves (built-ins, actions, conditions), so
+    /// that ticking a leaf costs no call; the control and decorator
+    /// families are `#[inline(never)]`, which ends the recursion there and
+    /// keeps their frames off a leaf's path (this halved the time per leaf
+    /// tick).
     #[inline(always)]
     pub(crate) fn tick_node(&mut self, i: u32) -> Status {
         let iu = i as usize;
