@@ -73,7 +73,7 @@ fn slice_in<'a>(text: &'a str, part: &[u8]) -> Option<&'a str> {
     text.get(start..start.checked_add(part.len())?)
 }
 
-impl<'a> Elem<'a> {
+impl Elem<'_> {
     /// Where attribute `k`'s name is (the element's `<` without it).
     fn attr_at(&self, k: &str) -> usize {
         self.attrs
@@ -173,7 +173,7 @@ fn ports(e: &Elem, skip: &[&str]) -> Vec<(String, PortValue)> {
         .filter(|a| {
             a.key != "name" && !skip.contains(&a.key) && !NodeScripts::ATTRIBUTES.contains(&a.key)
         })
-        .map(|a| (a.key.to_owned(), port_value(a.value.clone().into_owned())))
+        .map(|a| (a.key.to_owned(), port_value(a.value.to_string())))
         .collect()
 }
 
@@ -184,7 +184,7 @@ fn node_scripts(e: &Elem) -> Result<NodeScripts, LoadError> {
     for a in &e.attrs {
         let k = a.key;
         match NodeScripts::ATTRIBUTES.iter().position(|s| *s == k) {
-            Some(i) => *scripts.slot(i) = Some(a.value.clone().into_owned()),
+            Some(i) => *scripts.slot(i) = Some(a.value.to_string()),
             None if k.starts_with('_') && k != "_autoremap" => {
                 let known = NodeScripts::ATTRIBUTES
                     .iter()
