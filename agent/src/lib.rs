@@ -13,4 +13,6 @@ pub mod replan;
 pub mod sim;
 pub mod trial;
 
-pub use replan::{run_loop, run_loop_traced, LoopError, LoopOptions, LoopSummary};
+pub use replan::{
+    run_loop, run_loop_traced, run_loop_with, InstallLeaves, LoopError, LoopOptions, LoopSummary,
+};

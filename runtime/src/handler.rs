@@ -14,6 +14,8 @@ pub struct ActionCall<'a> {
     pub starting: bool,
     pub(crate) ports: &'a [PortBind],
     pub(crate) bb: &'a [Value],
+    /// Why the leaf failed, when its implementation says so.
+    reason: std::cell::RefCell<Option<String>>,
 }
 
 impl ActionCall<'_> {
@@ -26,6 +28,16 @@ impl ActionCall<'_> {
                 Src::Const(v) => v,
                 Src::Slot(k) => &self.bb[*k as usize],
             })
+    }
+}
+
+impl ActionCall<'_> {
+    /// Fails the leaf for a reason told in the user's words ("the gripper
+    /// dropped the part"): the fault record of the failure says it.
+    /// Returning FAILURE without it records that the leaf failed.
+    pub fn fail(&self, why: impl Into<String>) -> Status {
+        *self.reason.borrow_mut() = Some(why.into());
+        Status::Failure
     }
 }
 
@@ -56,7 +68,18 @@ impl<'w> Engine<'w> {
             starting: self.status[i as usize] != Status::Running,
             ports: &self.ports[p as usize..q as usize],
             bb: &self.bb,
+            reason: Default::default(),
         };
-        (self.handlers[h as usize])(&call)
+        let status = (self.handlers[h as usize])(&call);
+        if status == Status::Failure {
+            let why = call.reason.into_inner().unwrap_or_else(|| {
+                format!(
+                    "the `{}` leaf's implementation returned FAILURE",
+                    self.actions[a as usize].id
+                )
+            });
+            self.note_failure(i, crate::engine::Reason::Plain(why));
+        }
+        status
     }
 }

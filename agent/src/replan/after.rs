@@ -9,7 +9,7 @@ use btc_pddl::diagnostic::codes;
 use btc_pddl::logic::{Formula, Terms};
 use btc_runtime::engine::Status;
 
-impl Run<'_> {
+impl Run<'_, '_> {
     /// Stops the loop (and says why) when a failed attempt used up its ticks
     /// or replans.
     pub(super) fn out_of_limits(&mut self, ran: &Ran) -> bool {

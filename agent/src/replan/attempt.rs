@@ -31,7 +31,7 @@ pub(super) struct Ran {
     pub last_record: Option<FaultRecord>,
 }
 
-impl Run<'_> {
+impl Run<'_, '_> {
     /// Compiles and runs attempt `attempt` for `goal`, and records it.
     pub(super) fn attempt(
         &mut self,
@@ -84,6 +84,9 @@ impl Run<'_> {
         kb.set_goal(g);
         let mut engine =
             Engine::build(&doc, Some(kb), self.opts.engine.clone()).map_err(LoopError::Tree)?;
+        if let Some(install) = self.leaves.as_mut() {
+            install(&mut engine);
+        }
         engine.tick = self.carry.tick;
         match self.carry.faults.take() {
             Some(f) => engine.restore_faults(f),

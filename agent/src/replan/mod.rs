@@ -22,7 +22,7 @@ use btc_pddl::diagnostic::{codes, Diagnostic};
 use btc_pddl::logic::Formula;
 use btc_pddl::source::Span;
 use btc_pddl::state::World;
-use btc_runtime::engine::{FaultRecord, Options, Status};
+use btc_runtime::engine::{Engine, FaultRecord, Options, Status};
 use btc_runtime::error::LoadError;
 use btc_runtime::faults::{FaultOutcome, Scenario};
 use carry::Carry;
@@ -177,6 +177,25 @@ pub fn run_loop_traced(
     opts: &LoopOptions,
     trace_out: &mut dyn std::io::Write,
 ) -> Result<LoopSummary, LoopError> {
+    run_loop_with(db, job, given_plan, scenario, opts, trace_out, None)
+}
+
+/// Installs an embedder's leaves in each attempt's engine, before it ticks
+/// (`Engine::set_action_handler` for the node ids it implements).
+pub type InstallLeaves<'a, 'l> = &'a mut (dyn FnMut(&mut Engine<'_>) + 'l);
+
+/// [`run_loop_traced`], with the action leaves `leaves` installs ticking
+/// the embedder's code instead of the simulated world's actions: the
+/// library facade's agent runs the loop this way.
+pub fn run_loop_with(
+    db: &mut Database,
+    job: CompileJob,
+    given_plan: bool,
+    scenario: Option<&Scenario>,
+    opts: &LoopOptions,
+    trace_out: &mut dyn std::io::Write,
+    leaves: Option<InstallLeaves<'_, '_>>,
+) -> Result<LoopSummary, LoopError> {
     let t0 = Instant::now();
     let goal_span = world(db, job)?.problem.goal.as_ref().map_or(
         Span::new(problem_file_id(db, job), 0, 0),
@@ -199,6 +218,7 @@ pub fn run_loop_traced(
         scenario,
         opts,
         trace_out,
+        leaves,
         out: LoopSummary::new(base_goal.to_string()),
         world: the_world,
         base_goal,
@@ -222,7 +242,7 @@ pub fn run_loop_traced(
 }
 
 /// A loop under way: its inputs, the world, and what it has come to.
-struct Run<'a> {
+struct Run<'a, 'l> {
     db: &'a mut Database,
     job: CompileJob,
     plan_path: FilePath,
@@ -230,6 +250,7 @@ struct Run<'a> {
     scenario: Option<&'a Scenario>,
     opts: &'a LoopOptions,
     trace_out: &'a mut dyn std::io::Write,
+    leaves: Option<InstallLeaves<'a, 'l>>,
     world: World,
     /// The problem's goal, before any adjustment.
     base_goal: Formula,
@@ -239,7 +260,7 @@ struct Run<'a> {
     out: LoopSummary,
 }
 
-impl Run<'_> {
+impl Run<'_, '_> {
     /// Plans, compiles and runs attempts until the goal holds or the loop
     /// must stop.
     fn attempts(&mut self) -> Result<(), LoopError> {

@@ -29,7 +29,7 @@ pub(super) enum Planned {
     Stopped,
 }
 
-impl Run<'_> {
+impl Run<'_, '_> {
     /// Plans attempt `attempt` for `goal` from the carried state.
     pub(super) fn plan(
         &mut self,

@@ -1,0 +1,215 @@
+//! A compiled tree: every emitter's text, and a run in btc's engine against
+//! the problem's world with the embedder's own leaves.
+
+use crate::diagnostic::{Diagnostic, Error};
+use crate::faults::Faults;
+use btc_emit as emit;
+use btc_ir::TreeIr;
+use btc_pddl::state::World;
+use btc_runtime::engine::TraceItem;
+use btc_runtime::{ActionCall, Engine, FaultOutcome, FaultRecord, Kb, Status, TreeDoc};
+use serde::Serialize;
+use std::sync::Arc;
+
+/// The outputs `btc compile --emit` writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Target {
+    BtcppXml,
+    PyTrees,
+    Json,
+    Dot,
+    Mermaid,
+    Commands,
+}
+
+#[derive(Clone, Debug)]
+pub struct Tree {
+    ir: Arc<TreeIr>,
+    /// Why a py_trees module cannot run this tree as btc's engine does
+    /// (empty when it can).
+    pytrees_refusals: Vec<Diagnostic>,
+}
+
+/// How a run goes.
+#[derive(Clone, Debug)]
+pub struct RunOptions {
+    /// Ticks a simulated action (one no handler takes) stays RUNNING.
+    pub ticks_per_action: u32,
+    /// Simulated milliseconds per tick (what `timeout` and `delay` count).
+    pub ms_per_tick: u64,
+    pub max_ticks: u64,
+}
+
+impl Default for RunOptions {
+    fn default() -> Self {
+        RunOptions {
+            ticks_per_action: 1,
+            ms_per_tick: 10,
+            max_ticks: 100_000,
+        }
+    }
+}
+
+/// A leaf the embedder implements, for every action leaf of one node id.
+pub type Handler<'h> = Box<dyn FnMut(&ActionCall<'_>) -> Status + 'h>;
+
+/// A step started or ended, at a tick.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct StepEvent {
+    pub tick: u64,
+    pub started: bool,
+    /// 0-based plan step.
+    pub step: u32,
+}
+
+/// What a run came to.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RunReport {
+    pub status: Status,
+    pub ticks: u64,
+    pub steps_done: usize,
+    pub steps_total: usize,
+    /// Whether the problem's goal holds at the end, and if not, why.
+    pub goal_reached: bool,
+    pub goal_failure: Option<String>,
+    pub steps: Vec<StepEvent>,
+    pub faults: Vec<FaultOutcome>,
+    pub records: Vec<FaultRecord>,
+    /// The final facts and values, sorted.
+    pub kb: Vec<String>,
+}
+
+impl RunReport {
+    pub fn success(&self) -> bool {
+        self.status == Status::Success && self.goal_reached
+    }
+}
+
+impl Tree {
+    pub(crate) fn new(ir: Arc<TreeIr>, pytrees_refusals: Vec<Diagnostic>) -> Tree {
+        Tree {
+            ir,
+            pytrees_refusals,
+        }
+    }
+
+    /// The tree IR itself, for crates that build on btc's internals.
+    pub fn ir(&self) -> &Arc<TreeIr> {
+        &self.ir
+    }
+
+    /// The plan's steps, `(action arg ...)`.
+    pub fn steps(&self) -> Vec<String> {
+        self.ir.steps.iter().map(|s| s.display()).collect()
+    }
+
+    /// The tree in a target's form. py_trees is refused (with the
+    /// diagnostics that say where) when the tree uses what a py_trees
+    /// module cannot run as btc's engine does.
+    pub fn emit(&self, target: Target) -> Result<String, Error> {
+        let format = match target {
+            Target::BtcppXml => emit::Format::Btcpp,
+            Target::PyTrees => {
+                if !self.pytrees_refusals.is_empty() {
+                    return Err(Error::new(self.pytrees_refusals.clone()));
+                }
+                emit::Format::Pytrees
+            }
+            Target::Json => emit::Format::Json,
+            Target::Dot => emit::Format::Dot,
+            Target::Mermaid => emit::Format::Mermaid,
+            Target::Commands => emit::Format::Commands,
+        };
+        Ok(emit::emit(&self.ir, format, &emit::Options::default()))
+    }
+
+    pub fn to_btcpp_xml(&self) -> String {
+        emit::emit(&self.ir, emit::Format::Btcpp, &emit::Options::default())
+    }
+
+    pub fn to_json(&self) -> String {
+        emit::emit(&self.ir, emit::Format::Json, &emit::Options::default())
+    }
+
+    pub fn to_dot(&self) -> String {
+        emit::emit(&self.ir, emit::Format::Dot, &emit::Options::default())
+    }
+
+    pub fn to_mermaid(&self) -> String {
+        emit::emit(&self.ir, emit::Format::Mermaid, &emit::Options::default())
+    }
+
+    /// Runs the tree in btc's engine against the problem's initial state:
+    /// action leaves whose id `handlers` names tick the embedder's code,
+    /// the others are simulated as `btc run` simulates them.
+    pub fn run<'h>(
+        &self,
+        options: &RunOptions,
+        handlers: Vec<(String, Handler<'h>)>,
+        faults: Option<&Faults>,
+    ) -> Result<RunReport, Error> {
+        let world = World::new(self.ir.world.clone()).map_err(|m| {
+            Error::one(Diagnostic::without_place(
+                btc_pddl::diagnostic::codes::X_WORLD.id,
+                format!("the tree's world does not fit together: {m}"),
+                &self.ir.problem,
+            ))
+        })?;
+        let doc = TreeDoc::from_ir(&self.ir);
+        let opts = btc_runtime::Options {
+            ticks_per_action: options.ticks_per_action,
+            ms_per_tick: options.ms_per_tick,
+            trace: true,
+        };
+        let tree_error = |e: btc_runtime::LoadError| crate::faults::load_error(&e, &self.ir.plan);
+        let mut engine = Engine::build(&doc, Some(Kb::new(&world)), opts).map_err(tree_error)?;
+        for (id, h) in handlers {
+            if engine.set_action_handler(&id, h) == 0 {
+                return Err(Error::one(
+                    Diagnostic::without_place(
+                        btc_pddl::diagnostic::codes::X_UNKNOWN_NODE.id,
+                        format!("no action leaf of this tree has the id `{id}`"),
+                        &self.ir.rules,
+                    )
+                    .hint("a handler takes the action leaves of one node id the rules declare"),
+                ));
+            }
+        }
+        if let Some(f) = faults {
+            engine.add_faults(&f.scenario).map_err(|e| f.error(&e))?;
+        }
+        let mut steps = Vec::new();
+        let status = engine.run(options.max_ticks, |e| step_events(&mut e.trace, &mut steps));
+        step_events(&mut engine.trace, &mut steps);
+        let sum = engine.summary(status);
+        Ok(RunReport {
+            status,
+            ticks: sum.ticks,
+            steps_done: sum.steps_done,
+            steps_total: sum.steps_total,
+            goal_reached: sum.goal_reached.unwrap_or(true),
+            goal_failure: sum.goal_failure,
+            steps,
+            faults: sum.faults,
+            records: sum.records,
+            kb: engine.kb.as_ref().map(Kb::snapshot).unwrap_or_default(),
+        })
+    }
+}
+
+/// The step starts and ends of the trace so far, which is then forgotten
+/// (a long run keeps no trace).
+fn step_events(trace: &mut Vec<TraceItem>, out: &mut Vec<StepEvent>) {
+    for t in trace.drain(..) {
+        let (tick, started, step) = match t {
+            TraceItem::StepStarted { tick, step } => (tick, true, step),
+            TraceItem::StepFinished { tick, step } => (tick, false, step),
+            _ => continue,
+        };
+        out.push(StepEvent {
+            tick,
+            started,
+            step,
+        });
+    }
+}
