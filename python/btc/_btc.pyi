@@ -1,0 +1,58 @@
+"""Type stubs of btc's native module (re-exported by ``btc``)."""
+
+import os
+from typing import Union
+
+StrPath = Union[str, "os.PathLike[str]"]
+
+__version__: str
+
+class BtcError(Exception):
+    """Bad input: ``diagnostics`` says what and where."""
+
+    diagnostics: list[Diagnostic]
+
+class Diagnostic:
+    code: str
+    severity: str
+    message: str
+    path: str
+    line: int
+    column: int
+    end_line: int
+    end_column: int
+    hint: str | None
+    fixes: list[tuple[str, str, int, int, int, int, str]]
+
+class Step:
+    action: str
+    args: list[str]
+    time: float | None
+    duration: float | None
+
+class Plan:
+    @staticmethod
+    def parse(text: str) -> Plan: ...
+    @property
+    def steps(self) -> list[Step]: ...
+    @property
+    def cost(self) -> float | None: ...
+    def __len__(self) -> int: ...
+
+class Tree:
+    def to_btcpp_xml(self) -> str: ...
+    def to_json(self) -> str: ...
+    def to_mermaid(self) -> str: ...
+    def to_dot(self) -> str: ...
+    @property
+    def steps(self) -> list[str]: ...
+
+class Project:
+    def __init__(self, path: StrPath) -> None: ...
+    @staticmethod
+    def from_texts(*, rules: str, domain: str, problem: str | None = None) -> Project: ...
+    def check(self) -> list[Diagnostic]: ...
+    def plan(self, problem: StrPath | None = None) -> Plan: ...
+    def compile(self, plan: Plan, problem: StrPath | None = None) -> Tree: ...
+
+def plan(domain: StrPath, problem: StrPath) -> Plan: ...

@@ -1,0 +1,1 @@
+../../emit/python/btc_runtime.py

@@ -1,0 +1,283 @@
+//! The Python face of btc-api: the classes of the `btc` package
+//! (`btc/__init__.py` re-exports them). Texts and paths come in, plain
+//! Python values go out; bad input raises `btc.BtcError` carrying the
+//! diagnostics, never a crash of the host process.
+
+use btc_api as api;
+use pyo3::create_exception;
+use pyo3::exceptions::PyException;
+use pyo3::prelude::*;
+use std::path::PathBuf;
+
+create_exception!(_btc, BtcError, PyException, "Bad input: `.diagnostics` says what and where.");
+
+/// What went wrong, where, and what to do.
+#[pyclass(module = "btc", frozen, get_all)]
+#[derive(Clone)]
+struct Diagnostic {
+    code: String,
+    /// `"error"` or `"warning"`.
+    severity: String,
+    message: String,
+    path: String,
+    line: u32,
+    column: u32,
+    end_line: u32,
+    end_column: u32,
+    hint: Option<String>,
+    /// Machine-applicable repairs: `(title, path, line, column, end_line,
+    /// end_column, replacement)`.
+    fixes: Vec<(String, String, u32, u32, u32, u32, String)>,
+}
+
+#[pymethods]
+impl Diagnostic {
+    fn __str__(&self) -> String {
+        let mut s = format!(
+            "{}:{}:{}: {}[{}]: {}",
+            self.path, self.line, self.column, self.severity, self.code, self.message
+        );
+        if let Some(h) = &self.hint {
+            s.push_str(&format!(" (hint: {h})"));
+        }
+        s
+    }
+
+    fn __repr__(&self) -> String {
+        format!("<Diagnostic {} {}:{}:{}>", self.code, self.path, self.line, self.column)
+    }
+}
+
+impl From<&api::Diagnostic> for Diagnostic {
+    fn from(d: &api::Diagnostic) -> Diagnostic {
+        Diagnostic {
+            code: d.code.clone(),
+            severity: match d.severity {
+                api::Severity::Error => "error",
+                api::Severity::Warning => "warning",
+            }
+            .to_owned(),
+            message: d.message.clone(),
+            path: d.path.clone(),
+            line: d.start.line,
+            column: d.start.column,
+            end_line: d.end.line,
+            end_column: d.end.column,
+            hint: d.hint.clone(),
+            fixes: d
+                .fixes
+                .iter()
+                .map(|f| {
+                    (
+                        f.title.clone(),
+                        f.path.clone(),
+                        f.start.line,
+                        f.start.column,
+                        f.end.line,
+                        f.end.column,
+                        f.replacement.clone(),
+                    )
+                })
+                .collect(),
+        }
+    }
+}
+
+/// `btc.BtcError(message, diagnostics)`, raised.
+fn raise(py: Python<'_>, e: api::Error) -> PyErr {
+    let diags: Vec<Diagnostic> = e.diagnostics.iter().map(Diagnostic::from).collect();
+    let err = BtcError::new_err(e.to_string());
+    match diags.into_pyobject(py) {
+        Ok(list) => {
+            let _ = err.value(py).setattr("diagnostics", list);
+            err
+        }
+        Err(x) => x,
+    }
+}
+
+/// One step of a plan.
+#[pyclass(module = "btc", frozen, get_all)]
+#[derive(Clone)]
+struct Step {
+    action: String,
+    args: Vec<String>,
+    time: Option<f64>,
+    duration: Option<f64>,
+}
+
+#[pymethods]
+impl Step {
+    fn __str__(&self) -> String {
+        self.value().to_string()
+    }
+
+    fn __repr__(&self) -> String {
+        format!("<Step {}>", self.value())
+    }
+}
+
+impl Step {
+    fn value(&self) -> api::Step {
+        api::Step {
+            action: self.action.clone(),
+            args: self.args.clone(),
+            time: self.time,
+            duration: self.duration,
+        }
+    }
+}
+
+/// A plan: its steps and cost; `str()` is its sas_plan text.
+#[pyclass(module = "btc", frozen)]
+struct Plan {
+    plan: api::Plan,
+}
+
+#[pymethods]
+impl Plan {
+    /// Reads a plan in any format btc reads (sas_plan, timed, bare lines,
+    /// FF's output).
+    #[staticmethod]
+    fn parse(py: Python<'_>, text: &str) -> PyResult<Plan> {
+        api::Plan::parse(text)
+            .map(|plan| Plan { plan })
+            .map_err(|e| raise(py, e))
+    }
+
+    #[getter]
+    fn steps(&self) -> Vec<Step> {
+        self.plan
+            .steps
+            .iter()
+            .map(|s| Step {
+                action: s.action.clone(),
+                args: s.args.clone(),
+                time: s.time,
+                duration: s.duration,
+            })
+            .collect()
+    }
+
+    #[getter]
+    fn cost(&self) -> Option<f64> {
+        self.plan.cost
+    }
+
+    fn __len__(&self) -> usize {
+        self.plan.steps.len()
+    }
+
+    fn __str__(&self) -> String {
+        self.plan.to_string()
+    }
+
+    fn __repr__(&self) -> String {
+        format!("<Plan of {} steps>", self.plan.steps.len())
+    }
+
+    fn __eq__(&self, other: &Plan) -> bool {
+        self.plan == other.plan
+    }
+}
+
+/// A compiled tree, in each of btc's output forms.
+#[pyclass(module = "btc", frozen)]
+struct Tree {
+    tree: api::Tree,
+}
+
+#[pymethods]
+impl Tree {
+    fn to_btcpp_xml(&self) -> String {
+        self.tree.to_btcpp_xml()
+    }
+
+    fn to_json(&self) -> String {
+        self.tree.to_json()
+    }
+
+    fn to_mermaid(&self) -> String {
+        self.tree.to_mermaid()
+    }
+
+    fn to_dot(&self) -> String {
+        self.tree.to_dot()
+    }
+
+    /// The plan's steps as `(action arg ...)`.
+    #[getter]
+    fn steps(&self) -> Vec<String> {
+        self.tree.steps()
+    }
+}
+
+/// A rules file and what it names, loaded once and kept: checking,
+/// planning and compiling again re-do only what changed.
+#[pyclass(module = "btc", unsendable)]
+struct Project {
+    project: api::Project,
+}
+
+#[pymethods]
+impl Project {
+    #[new]
+    fn open(py: Python<'_>, path: PathBuf) -> PyResult<Project> {
+        api::Project::open(&path)
+            .map(|project| Project { project })
+            .map_err(|e| raise(py, e))
+    }
+
+    /// A project from texts (nothing is read from disk).
+    #[staticmethod]
+    #[pyo3(signature = (*, rules, domain, problem=None))]
+    fn from_texts(py: Python<'_>, rules: &str, domain: &str, problem: Option<&str>) -> PyResult<Project> {
+        api::Project::from_texts(rules, domain, problem)
+            .map(|project| Project { project })
+            .map_err(|e| raise(py, e))
+    }
+
+    /// Every diagnostic of the rules, their imports, domain and problem.
+    fn check(&self) -> Vec<Diagnostic> {
+        self.project.check().iter().map(Diagnostic::from).collect()
+    }
+
+    /// A plan for `problem` (a path; default: the project's problem).
+    #[pyo3(signature = (problem=None))]
+    fn plan(&mut self, py: Python<'_>, problem: Option<PathBuf>) -> PyResult<Plan> {
+        self.project
+            .plan(problem.as_deref())
+            .map(|plan| Plan { plan })
+            .map_err(|e| raise(py, e))
+    }
+
+    /// Compiles `plan` with the rules for `problem`.
+    #[pyo3(signature = (plan, problem=None))]
+    fn compile(&mut self, py: Python<'_>, plan: &Plan, problem: Option<PathBuf>) -> PyResult<Tree> {
+        self.project
+            .compile(&plan.plan, problem.as_deref())
+            .map(|tree| Tree { tree })
+            .map_err(|e| raise(py, e))
+    }
+}
+
+/// A plan for `problem` in `domain` (paths), without rules.
+#[pyfunction]
+fn plan(py: Python<'_>, domain: PathBuf, problem: PathBuf) -> PyResult<Plan> {
+    api::plan(&domain, &problem)
+        .map(|plan| Plan { plan })
+        .map_err(|e| raise(py, e))
+}
+
+#[pymodule]
+fn _btc(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", api::VERSION)?;
+    m.add("BtcError", m.py().get_type::<BtcError>())?;
+    m.add_class::<Diagnostic>()?;
+    m.add_class::<Step>()?;
+    m.add_class::<Plan>()?;
+    m.add_class::<Tree>()?;
+    m.add_class::<Project>()?;
+    m.add_function(wrap_pyfunction!(plan, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,174 @@
+"""The `btc` package under a real Python: projects, plans and trees made
+in-process are those the `btc` command makes from the same files, and bad
+input of any kind raises `btc.BtcError` with diagnostics."""
+
+import os
+import pathlib
+import shutil
+import subprocess
+
+import pytest
+
+import btc
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+EXAMPLES = {
+    "ariac": "plan.txt",
+    "nist_kitting": "plan.plan",
+    "p3_assembler": "plan.tplan",
+    "two_robots": "plan.plan",
+}
+
+
+def btc_command():
+    """The `btc` binary to compare with: `BTC_BIN`, or the debug build."""
+    found = os.environ.get("BTC_BIN") or shutil.which("btc")
+    built = ROOT / "target" / "debug" / "btc"
+    if not found and built.exists():
+        found = str(built)
+    if not found:
+        if os.environ.get("CI") == "true":
+            pytest.fail("needs the btc binary: run `cargo build` or set BTC_BIN")
+        pytest.skip("needs the btc binary: run `cargo build` or set BTC_BIN")
+    return found
+
+
+def run_btc(*args):
+    out = subprocess.run(
+        [btc_command(), *args], cwd=ROOT, capture_output=True, text=True, check=False
+    )
+    assert out.returncode == 0, out.stderr
+    return out.stdout
+
+
+def test_version_is_the_crates():
+    cargo = (ROOT / "Cargo.toml").read_text()
+    assert f'version = "{btc.__version__}"' in cargo
+
+
+@pytest.mark.parametrize("example", sorted(EXAMPLES))
+def test_a_tree_compiled_in_process_is_the_one_btc_compile_writes(example):
+    folder = ROOT / "examples" / example
+    project = btc.Project(folder / "rules.btrules")
+    assert [d for d in project.check() if d.severity == "error"] == []
+    plan_file = folder / EXAMPLES[example]
+    plan = btc.Plan.parse(plan_file.read_text())
+    tree = project.compile(plan)
+    rel = f"examples/{example}"
+    cli = run_btc("compile", f"{rel}/rules.btrules", "--plan", f"{rel}/{EXAMPLES[example]}")
+    assert tree.to_btcpp_xml() == cli
+    mermaid = run_btc(
+        "compile",
+        f"{rel}/rules.btrules",
+        "--plan",
+        f"{rel}/{EXAMPLES[example]}",
+        "--emit",
+        "mermaid",
+    )
+    assert tree.to_mermaid() == mermaid
+
+
+def test_plans_made_in_process_are_btc_plans():
+    folder = ROOT / "examples" / "ariac"
+    # Paths as str and as os.PathLike.
+    ours = btc.plan(str(folder / "domain.pddl"), folder / "problem.pddl")
+    cli = btc.Plan.parse(
+        run_btc("plan", "examples/ariac/domain.pddl", "examples/ariac/problem.pddl", "--quiet")
+    )
+    assert ours == cli
+    assert [s.action for s in ours.steps] == ["move", "grasp", "move", "place"]
+    assert ours.cost == 4
+    assert btc.Plan.parse(str(ours)) == ours
+    project = btc.Project(str(folder / "rules.btrules"))
+    assert project.plan() == ours
+    assert project.plan(folder / "problem.pddl") == ours
+    tree = project.compile(ours)
+    assert tree.steps == [str(s) for s in ours.steps]
+
+
+def test_a_project_from_texts_checks_plans_and_compiles():
+    folder = ROOT / "examples" / "ariac"
+    texts = btc.Project.from_texts(
+        rules=(folder / "rules.btrules").read_text(),
+        domain=(folder / "domain.pddl").read_text(),
+        problem=(folder / "problem.pddl").read_text(),
+    )
+    disk = btc.Project(folder / "rules.btrules")
+    assert [d.code for d in texts.check()] == [d.code for d in disk.check()]
+    plan = texts.plan()
+    assert texts.compile(plan).to_btcpp_xml() == disk.compile(plan).to_btcpp_xml()
+    assert texts.compile(plan).to_json().startswith("{")
+    assert texts.compile(plan).to_dot().startswith("digraph")
+
+
+def test_diagnostics_say_what_and_where():
+    domain = (ROOT / "examples" / "ariac" / "domain.pddl").read_text()
+    project = btc.Project.from_texts(
+        rules='domain "domain.pddl"\nrule (fly ?r) { Fly(r: ?r) }\n', domain=domain
+    )
+    diags = project.check()
+    assert diags, "an action the domain lacks is reported"
+    d = next(d for d in diags if d.severity == "error")
+    assert d.path == "rules.btrules"
+    assert d.line == 2
+    assert d.column >= 1
+    assert d.code.startswith("R")
+    assert d.code in str(d)
+
+
+def test_bad_input_raises_btc_error_with_diagnostics():
+    with pytest.raises(btc.BtcError) as e:
+        btc.Project("/nonexistent/rules.btrules")
+    assert e.value.diagnostics[0].code == "F001"
+    with pytest.raises(btc.BtcError) as e:
+        btc.Plan.parse("0.000: (move a b [oops")
+    assert all(d.path == "<plan>" and d.line == 1 for d in e.value.diagnostics)
+    project = btc.Project(ROOT / "examples" / "ariac" / "rules.btrules")
+    with pytest.raises(btc.BtcError) as e:
+        project.compile(btc.Plan.parse("(fly robot1 moon)\n"))
+    assert "fly" in str(e.value)
+    assert any(d.severity == "error" for d in e.value.diagnostics)
+    with pytest.raises(btc.BtcError):
+        project.plan(ROOT / "examples" / "ariac" / "nope.pddl")
+    with pytest.raises(TypeError):
+        btc.Project(42)
+
+
+HOSTILE = [
+    "",
+    "\0" * 64,
+    "(" * 100_000,
+    ")" * 1000,
+    "rule",
+    'domain "/dev/zero"',
+    "\ufeff(define",
+    "é" * 10_000,
+    "\ud7ff\ue000",
+    'domain "domain.pddl"\n' + "rule (a) { " * 5000,
+]
+
+
+@pytest.mark.parametrize("text", HOSTILE, ids=range(len(HOSTILE)))
+def test_hostile_texts_never_crash_the_process(text):
+    try:
+        project = btc.Project.from_texts(rules=text, domain=text, problem=text)
+    except btc.BtcError as e:
+        assert e.diagnostics
+    else:
+        project.check()
+        with pytest.raises(btc.BtcError):
+            project.plan()
+    try:
+        btc.Plan.parse(text)
+    except btc.BtcError as e:
+        assert e.diagnostics
+
+
+def test_the_package_carries_btcs_py_trees_runtime():
+    import py_trees
+
+    from btc import btc_runtime
+
+    source = (ROOT / "emit" / "python" / "btc_runtime.py").read_text()
+    assert pathlib.Path(btc_runtime.__file__).read_text() == source
+    assert issubclass(btc_runtime.Action, py_trees.behaviour.Behaviour)
