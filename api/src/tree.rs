@@ -123,6 +123,20 @@ impl Tree {
         Ok(emit::emit(&self.ir, format, &emit::Options::default()))
     }
 
+    /// The py_trees module `btc compile --emit pytrees --runtime import`
+    /// writes: the tree as data (world, plan, leaf classes, trees) over
+    /// btc's py_trees runtime. Refused as [`Tree::emit`] refuses it.
+    pub fn pytrees_module(&self) -> Result<String, Error> {
+        if !self.pytrees_refusals.is_empty() {
+            return Err(Error::new(self.pytrees_refusals.clone()));
+        }
+        let opts = emit::Options {
+            runtime: emit::pytrees::Runtime::Import,
+            ..emit::Options::default()
+        };
+        Ok(emit::emit(&self.ir, emit::Format::Pytrees, &opts))
+    }
+
     pub fn to_btcpp_xml(&self) -> String {
         emit::emit(&self.ir, emit::Format::Btcpp, &emit::Options::default())
     }

@@ -9,7 +9,12 @@ use pyo3::exceptions::PyException;
 use pyo3::prelude::*;
 use std::path::PathBuf;
 
-create_exception!(_btc, BtcError, PyException, "Bad input: `.diagnostics` says what and where.");
+create_exception!(
+    _btc,
+    BtcError,
+    PyException,
+    "Bad input: `.diagnostics` says what and where."
+);
 
 /// What went wrong, where, and what to do.
 #[pyclass(module = "btc", frozen, get_all)]
@@ -44,7 +49,10 @@ impl Diagnostic {
     }
 
     fn __repr__(&self) -> String {
-        format!("<Diagnostic {} {}:{}:{}>", self.code, self.path, self.line, self.column)
+        format!(
+            "<Diagnostic {} {}:{}:{}>",
+            self.code, self.path, self.line, self.column
+        )
     }
 }
 
@@ -185,6 +193,30 @@ impl Plan {
 #[pyclass(module = "btc", frozen)]
 struct Tree {
     tree: api::Tree,
+    /// The py_trees module read as data (`btc._pytrees.TreeData`), once.
+    data: std::sync::OnceLock<Py<PyAny>>,
+}
+
+impl Tree {
+    fn new(tree: api::Tree) -> Tree {
+        Tree {
+            tree,
+            data: std::sync::OnceLock::new(),
+        }
+    }
+
+    fn data<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        if let Some(d) = self.data.get() {
+            return Ok(d.bind(py).clone());
+        }
+        let text = self.pytrees_module(py)?;
+        let d = py
+            .import("btc._pytrees")?
+            .getattr("TreeData")?
+            .call1((text,))?;
+        let _ = self.data.set(d.clone().unbind());
+        Ok(d)
+    }
 }
 
 #[pymethods]
@@ -203,6 +235,47 @@ impl Tree {
 
     fn to_dot(&self) -> String {
         self.tree.to_dot()
+    }
+
+    /// The py_trees module's text (`btc compile --emit pytrees --runtime
+    /// import`); `to_py_trees` reads its data without running it.
+    fn pytrees_module(&self, py: Python<'_>) -> PyResult<String> {
+        self.tree.pytrees_module().map_err(|e| raise(py, e))
+    }
+
+    /// The tree as py_trees behaviours, built in this process: leaf
+    /// classes from `nodes` (a module, or a mapping of node id -> class)
+    /// where it names them, btc's own otherwise (simulated actions, and
+    /// conditions that evaluate their formulas on the knowledge base).
+    /// Run it with the knowledge base of `knowledge_base()` on the
+    /// blackboard (`btc.btc_runtime.run(root, kb, max_ticks)`).
+    #[pyo3(signature = (nodes=None))]
+    fn to_py_trees<'py>(
+        &self,
+        py: Python<'py>,
+        nodes: Option<Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let data = self.data(py)?;
+        py.import("btc._pytrees")?
+            .call_method1("build", (data, nodes))
+    }
+
+    /// A fresh knowledge base for the tree: the problem's initial state and
+    /// the plan's steps, none started.
+    #[pyo3(signature = (ticks_per_action=1, ms_per_tick=10))]
+    fn knowledge_base<'py>(
+        &self,
+        py: Python<'py>,
+        ticks_per_action: u32,
+        ms_per_tick: u64,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let data = self.data(py)?;
+        let pt = py.import("btc._pytrees")?;
+        let world = pt.call_method1("world", (&data,))?;
+        let plan = pt.call_method1("plan", (&data,))?;
+        py.import("btc.btc_runtime")?
+            .getattr("KnowledgeBase")?
+            .call1((world, plan, ticks_per_action, ms_per_tick))
     }
 
     /// The plan's steps as `(action arg ...)`.
@@ -231,7 +304,12 @@ impl Project {
     /// A project from texts (nothing is read from disk).
     #[staticmethod]
     #[pyo3(signature = (*, rules, domain, problem=None))]
-    fn from_texts(py: Python<'_>, rules: &str, domain: &str, problem: Option<&str>) -> PyResult<Project> {
+    fn from_texts(
+        py: Python<'_>,
+        rules: &str,
+        domain: &str,
+        problem: Option<&str>,
+    ) -> PyResult<Project> {
         api::Project::from_texts(rules, domain, problem)
             .map(|project| Project { project })
             .map_err(|e| raise(py, e))
@@ -256,7 +334,7 @@ impl Project {
     fn compile(&mut self, py: Python<'_>, plan: &Plan, problem: Option<PathBuf>) -> PyResult<Tree> {
         self.project
             .compile(&plan.plan, problem.as_deref())
-            .map(|tree| Tree { tree })
+            .map(Tree::new)
             .map_err(|e| raise(py, e))
     }
 }

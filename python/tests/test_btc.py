@@ -2,11 +2,15 @@
 in-process are those the `btc` command makes from the same files, and bad
 input of any kind raises `btc.BtcError` with diagnostics."""
 
+import json
 import os
 import pathlib
 import shutil
 import subprocess
+import sys
+import types
 
+import py_trees
 import pytest
 
 import btc
@@ -55,7 +59,9 @@ def test_a_tree_compiled_in_process_is_the_one_btc_compile_writes(example):
     plan = btc.Plan.parse(plan_file.read_text())
     tree = project.compile(plan)
     rel = f"examples/{example}"
-    cli = run_btc("compile", f"{rel}/rules.btrules", "--plan", f"{rel}/{EXAMPLES[example]}")
+    cli = run_btc(
+        "compile", f"{rel}/rules.btrules", "--plan", f"{rel}/{EXAMPLES[example]}", "--emit", "btcpp"
+    )
     assert tree.to_btcpp_xml() == cli
     mermaid = run_btc(
         "compile",
@@ -172,3 +178,61 @@ def test_the_package_carries_btcs_py_trees_runtime():
     source = (ROOT / "emit" / "python" / "btc_runtime.py").read_text()
     assert pathlib.Path(btc_runtime.__file__).read_text() == source
     assert issubclass(btc_runtime.Action, py_trees.behaviour.Behaviour)
+
+
+def generated_module_run(example, tmp_path):
+    """The tree as `btc compile --emit pytrees` writes it, run by Python as a
+    program: the route the package replaces, and what it must agree with."""
+    rel = f"examples/{example}"
+    module = tmp_path / f"{example}_tree.py"
+    run_btc(
+        "compile", f"{rel}/rules.btrules", "--plan", f"{rel}/{EXAMPLES[example]}",
+        "--emit", "pytrees", "-o", str(module),
+    )  # fmt: skip
+    out = subprocess.run(
+        [sys.executable, str(module), "--json"], capture_output=True, text=True, check=False
+    )
+    return json.loads(out.stdout)
+
+
+@pytest.mark.parametrize("example", sorted(EXAMPLES))
+def test_a_tree_built_in_process_runs_as_the_generated_module(example, tmp_path):
+    from btc import btc_runtime
+
+    folder = ROOT / "examples" / example
+    project = btc.Project(folder / "rules.btrules")
+    tree = project.compile(btc.Plan.parse((folder / EXAMPLES[example]).read_text()))
+    root = tree.to_py_trees()
+    assert isinstance(root, py_trees.behaviour.Behaviour)
+    result = btc_runtime.run(root, tree.knowledge_base(), 10000)
+    assert result.as_json() == generated_module_run(example, tmp_path)
+    assert result.success()
+
+
+def test_a_partial_node_mapping_keeps_btcs_own_leaves():
+    from btc import btc_runtime
+
+    ticks = []
+
+    class Grasp(btc_runtime.Action):
+        def update(self):
+            ticks.append(self.name)
+            return py_trees.common.Status.SUCCESS
+
+    project = btc.Project(ROOT / "examples" / "ariac" / "rules.btrules")
+    tree = project.compile(project.plan())
+    # A mapping that names one action: MoveTo and Place stay simulated,
+    # RobotNormal evaluates its formula.
+    result = btc_runtime.run(tree.to_py_trees({"Grasp": Grasp}), tree.knowledge_base(), 100)
+    assert result.success()
+    assert len(ticks) == 1
+    # The same through a module's attributes.
+    module = types.ModuleType("my_nodes")
+    module.Grasp = Grasp
+    result = btc_runtime.run(tree.to_py_trees(module), tree.knowledge_base(), 100)
+    assert result.success() and len(ticks) == 2
+    # The condition is btc's: with the robot disabled the monitor fails.
+    kb = tree.knowledge_base()
+    kb.facts.discard(("is_enabled", "floor_robot"))
+    result = btc_runtime.run(tree.to_py_trees({"Grasp": Grasp}), kb, 100)
+    assert result.status == py_trees.common.Status.FAILURE
