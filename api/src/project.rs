@@ -46,6 +46,8 @@ pub struct Project {
     /// The problem given as a text: what `plan` and `compile` use when
     /// they are given none.
     problem: Option<FilePath>,
+    /// The compile job of each problem asked for so far.
+    jobs: Vec<(Option<FilePath>, CompileJob)>,
 }
 
 impl Project {
@@ -60,6 +62,7 @@ impl Project {
             files: Files::Disk,
             domain: None,
             problem: None,
+            jobs: Vec::new(),
         })
     }
 
@@ -107,6 +110,7 @@ impl Project {
             files: Files::Memory(files),
             domain: domain_named.is_none().then_some(domain_path),
             problem: problem.is_some().then_some(problem_path),
+            jobs: Vec::new(),
         })
     }
 
@@ -123,7 +127,7 @@ impl Project {
     /// A plan for `problem` (a path; `None`: the problem given as a text,
     /// or the one the rules file names) made by btc's planner.
     pub fn plan(&mut self, problem: Option<&Path>) -> Result<Plan, Error> {
-        let job = self.job(PlanSource::Planned(FilePath::new(PLAN_FILE)), problem)?;
+        let job = self.job(problem)?;
         self.refuse_errors(job, |d| d.span.file != self.plan_id(job))?;
         let w = self.world_of(job)?;
         let report = btc_planner::plan(w.domain, w.dix, w.problem, w.pix, &Default::default())
@@ -143,7 +147,7 @@ impl Project {
     /// chooses it): the plan is typed against the problem and replayed on
     /// it first, as `btc compile` does, and refused when it does not fit.
     pub fn compile(&mut self, plan: &Plan, problem: Option<&Path>) -> Result<Tree, Error> {
-        let job = self.job(PlanSource::Planned(FilePath::new(PLAN_FILE)), problem)?;
+        let job = self.job(problem)?;
         // The plan is the job's plan file: the database reads plans as
         // files (a plan value of its own is still to come).
         self.db
@@ -174,7 +178,7 @@ impl Project {
         &mut self,
         problem: Option<&Path>,
     ) -> Result<(&mut Database, CompileJob), Error> {
-        let job = self.job(PlanSource::Planned(FilePath::new(PLAN_FILE)), problem)?;
+        let job = self.job(problem)?;
         self.db.set_file(&FilePath::new(PLAN_FILE), String::new());
         self.refuse_errors(job, |d| d.span.file != self.plan_id(job))?;
         self.world_of(job)?;
@@ -214,15 +218,25 @@ impl Project {
         Error::new(convert(diags, &self.db.sources_for(diags)))
     }
 
-    fn job(&mut self, plan: PlanSource, problem: Option<&Path>) -> Result<CompileJob, Error> {
+    /// The compile job for a problem, loaded the first time it is asked
+    /// for and kept: a job is an input of the database, and its queries'
+    /// results live as long as it does, so an agent that plans and
+    /// compiles thousands of times holds one job per problem, not one per
+    /// call.
+    fn job(&mut self, problem: Option<&Path>) -> Result<CompileJob, Error> {
+        let problem = problem.map(FilePath::new).or_else(|| self.problem.clone());
+        if let Some((_, job)) = self.jobs.iter().find(|(p, _)| *p == problem) {
+            return Ok(*job);
+        }
         let paths = JobPaths {
             rules: self.rules.clone(),
-            plan,
-            problem: problem.map(FilePath::new).or_else(|| self.problem.clone()),
+            plan: PlanSource::Planned(FilePath::new(PLAN_FILE)),
+            problem: problem.clone(),
             domain: self.domain.clone(),
         };
         let loaded = project::load_job(&mut self.db, self.files.loader(), &paths)
             .map_err(|u| unreadable(&u.path, &u.why))?;
+        self.jobs.push((problem, loaded.job));
         Ok(loaded.job)
     }
 

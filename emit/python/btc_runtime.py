@@ -35,6 +35,7 @@ import argparse
 import json
 import sys
 import time
+import weakref
 from decimal import Decimal
 
 import py_trees
@@ -450,15 +451,31 @@ class Plan:
 # Behaviours that read and write the knowledge base
 
 
-class KbBehaviour(py_trees.behaviour.Behaviour):
+class _KbClient:
+    """A behaviour's blackboard client for `/btc/kb`, released when the
+    tree is shut down or the behaviour is collected: py_trees keeps every
+    registered client until it is unregistered, so a long-running agent
+    that builds a tree per plan would otherwise collect them."""
+
+    def _attach_kb(self, name, access):
+        client = self.attach_blackboard_client(name=name)
+        client.register_key(key=KB_KEY, access=access)
+        self._release_kb = weakref.finalize(self, client.unregister, False)
+        return client
+
+    def shutdown(self):
+        self._release_kb()
+        super().shutdown()
+
+
+class KbBehaviour(_KbClient, py_trees.behaviour.Behaviour):
     """A behaviour with a blackboard client for `/btc/kb`."""
 
     KB_ACCESS = READ
 
     def __init__(self, name):
         super().__init__(name=name)
-        self.blackboard = self.attach_blackboard_client(name=name)
-        self.blackboard.register_key(key=KB_KEY, access=self.KB_ACCESS)
+        self.blackboard = self._attach_kb(name, self.KB_ACCESS)
 
     @property
     def kb(self):
@@ -472,7 +489,7 @@ def _reset(child):
         child.stop(Status.INVALID)
 
 
-class PlanStep(py_trees.decorators.Decorator):
+class PlanStep(_KbClient, py_trees.decorators.Decorator):
     """The boundary of a plan step. When it starts it records the start and,
     if the step has at-start effects, checks the precondition and applies
     them (once); when its child succeeds it checks the at-end condition,
@@ -481,8 +498,7 @@ class PlanStep(py_trees.decorators.Decorator):
     def __init__(self, name, child, step):
         super().__init__(name=name, child=child)
         self.step = step
-        self.blackboard = self.attach_blackboard_client(name=name)
-        self.blackboard.register_key(key=KB_KEY, access=WRITE)
+        self.blackboard = self._attach_kb(name, WRITE)
 
     def tick(self):
         kb = self.blackboard.get(KB_KEY)
@@ -870,7 +886,7 @@ class Repeat(_Loop):
     AGAIN, END = Status.SUCCESS, Status.FAILURE
 
 
-class Timeout(_Decorator):
+class Timeout(_KbClient, _Decorator):
     """BT.CPP Timeout: FAILURE (the child halted) once `ms` milliseconds of
     the knowledge base's clock have passed since it started while the child
     is still RUNNING."""
@@ -879,8 +895,7 @@ class Timeout(_Decorator):
         super().__init__(name=name, child=child)
         self.ms = ms
         self.deadline = 0
-        self.blackboard = self.attach_blackboard_client(name=name)
-        self.blackboard.register_key(key=KB_KEY, access=READ)
+        self.blackboard = self._attach_kb(name, READ)
 
     def tick(self):
         kb = self.blackboard.get(KB_KEY)
@@ -900,7 +915,7 @@ class Timeout(_Decorator):
         yield from self._end(s)
 
 
-class Delay(_Decorator):
+class Delay(_KbClient, _Decorator):
     """BT.CPP Delay: RUNNING until `ms` milliseconds of the knowledge base's
     clock have passed since it started (the child untouched), then the
     child's status; the delay starts again after the child finishes."""
@@ -909,8 +924,7 @@ class Delay(_Decorator):
         super().__init__(name=name, child=child)
         self.ms = ms
         self.until = None
-        self.blackboard = self.attach_blackboard_client(name=name)
-        self.blackboard.register_key(key=KB_KEY, access=READ)
+        self.blackboard = self._attach_kb(name, READ)
 
     def initialise(self):
         self.until = None
@@ -1099,8 +1113,10 @@ def put_kb(kb):
 
 def run(root, kb, max_ticks):
     """Ticks `root` until it is no longer RUNNING or `max_ticks` ticks have
-    run (then it is halted); the knowledge base's clock advances each tick."""
-    put_kb(kb)
+    run (then it is halted); the knowledge base's clock advances each tick.
+    The tree's blackboard clients are released when it is shut down
+    (`py_trees.trees.BehaviourTree.shutdown()`) or collected."""
+    writer = put_kb(kb)
     tree = py_trees.trees.BehaviourTree(root)
     tree.setup()
     status = Status.RUNNING
@@ -1112,6 +1128,8 @@ def run(root, kb, max_ticks):
             break
     if status == Status.RUNNING:
         root.stop(Status.INVALID)
+    # The knowledge base stays on the blackboard; its writer goes.
+    writer.unregister(clear=False)
     return Result(status, kb.tick, kb)
 
 

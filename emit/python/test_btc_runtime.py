@@ -201,3 +201,42 @@ class StepTest(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class BlackboardClientsTest(unittest.TestCase):
+    """A long-running agent builds a tree per plan: a tree's blackboard
+    clients go when it is shut down or collected, and a run leaves none of
+    its own."""
+
+    def tree(self):
+        step = rt.Plan(((("a",), None, None, None, None, None),), ((0, ()),))
+        leaf = rt.Action("act", step=0)
+        root = rt.PlanStep("step 1", rt.Timeout("limit", leaf, 1000), 0)
+        return root, rt.KnowledgeBase(world(), step)
+
+    def clients(self):
+        return len(py_trees.blackboard.Blackboard.clients)
+
+    def test_a_run_then_shutdown_leaves_no_client(self):
+        before = self.clients()
+        root, kb = self.tree()
+        self.assertEqual(self.clients(), before + 3)
+        result = rt.run(root, kb, 10)
+        self.assertEqual(result.status, Status.SUCCESS)
+        self.assertEqual(self.clients(), before + 3)
+        py_trees.trees.BehaviourTree(root).shutdown()
+        self.assertEqual(self.clients(), before)
+        # Shutting down twice is harmless.
+        py_trees.trees.BehaviourTree(root).shutdown()
+        self.assertEqual(self.clients(), before)
+
+    def test_a_dropped_tree_releases_its_clients(self):
+        import gc
+
+        before = self.clients()
+        for _ in range(50):
+            root, kb = self.tree()
+            rt.run(root, kb, 10)
+        del root, kb
+        gc.collect()
+        self.assertEqual(self.clients(), before)

@@ -236,3 +236,36 @@ def test_a_partial_node_mapping_keeps_btcs_own_leaves():
     kb.facts.discard(("is_enabled", "floor_robot"))
     result = btc_runtime.run(tree.to_py_trees({"Grasp": Grasp}), kb, 100)
     assert result.status == py_trees.common.Status.FAILURE
+
+
+def test_ten_thousand_rounds_keep_the_blackboard_and_memory_flat():
+    """An agent's life: plan, compile, build and run a tree, again and
+    again, in one process. The blackboard's clients and the resident
+    memory stay flat (the count is the test; the time is not)."""
+    import gc
+    import resource
+
+    from btc import btc_runtime
+
+    project = btc.Project(ROOT / "examples" / "ariac" / "rules.btrules")
+    clients = py_trees.blackboard.Blackboard.clients
+
+    def round_trip():
+        tree = project.compile(project.plan())
+        result = btc_runtime.run(tree.to_py_trees(), tree.knowledge_base(), 100)
+        assert result.success()
+
+    for _ in range(500):
+        round_trip()
+    gc.collect()
+    settled = len(clients)
+    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss  # KiB
+    for i in range(9500):
+        round_trip()
+        if i % 1000 == 999:
+            gc.collect()
+            assert len(clients) == settled, f"round {i + 501}: {len(clients)} clients"
+    gc.collect()
+    assert len(clients) == settled
+    grown = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - rss
+    assert grown < 16 * 1024, f"resident memory grew by {grown} KiB over 9,500 rounds"
