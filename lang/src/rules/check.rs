@@ -995,11 +995,7 @@ pub fn rule_var_types(r: &Rule, decls: &Decls, ctx: Option<DomainCtx>) -> Vec<Va
     }
     let Some(c) = ctx else { return out };
     let reach = reach(r, decls, c);
-    let through_tables: Vec<_> = reach
-        .named
-        .iter()
-        .filter(|(_, _, _, v)| *v != Verdict::NotInTable)
-        .collect();
+    let through_tables = reach.meant();
     for action in typing_actions(&through_tables) {
         for v in &mut out {
             // The parameter at the variable's first position.
@@ -1072,11 +1068,7 @@ fn check_rule(r: &Rule, decls: &Decls, ctx: Option<DomainCtx>) -> Vec<Diagnostic
         return diags; // a pattern that did not parse: reported
     }
     let reach = reach(r, decls, c);
-    let through_tables: Vec<_> = reach
-        .named
-        .iter()
-        .filter(|(_, _, _, v)| *v != Verdict::NotInTable)
-        .collect();
+    let through_tables = reach.meant();
     if through_tables.is_empty() {
         let written = r.pattern.name_text();
         let candidate = closest(
