@@ -25,6 +25,10 @@ pub fn run(
         all_diags.extend(unit.diagnostics.iter().cloned());
         explicit = Some(unit);
     }
+    // The domains found beside problems, each loaded once; one the command
+    // line lists reports its diagnostics as its own file only.
+    let listed: Vec<PathBuf> = paths.iter().map(|p| same_file(p)).collect();
+    let mut found: Vec<(PathBuf, DomainUnit)> = Vec::new();
     for path in paths {
         let mut diags = Vec::new();
         let id = files::load(&mut sources, path, &mut diags)?;
@@ -51,16 +55,33 @@ pub fn run(
                 }
             }
             Some(Document::Problem(p)) => {
-                let found;
                 let du = match &explicit {
                     Some(u) => Some(u),
                     None => match find_domain(path, &p.domain.name) {
                         Some(dpath) => {
-                            let did = files::load(&mut sources, &dpath, &mut diags)?;
-                            let u = domain_unit(&sources, did);
-                            diags.extend(u.diagnostics.iter().filter(|d| d.is_error()).cloned());
-                            found = u;
-                            Some(&found)
+                            let key = same_file(&dpath);
+                            if !found.iter().any(|(k, _)| *k == key) {
+                                // A domain the command line does not list is
+                                // reported here once, in its own line: its
+                                // errors are not the problem's.
+                                let mut ddiags = Vec::new();
+                                let did = files::load(&mut sources, &dpath, &mut ddiags)?;
+                                let u = domain_unit(&sources, did);
+                                if !listed.contains(&key) {
+                                    ddiags.extend(u.diagnostics.iter().cloned());
+                                    let (e, w) = report::count(&ddiags);
+                                    summaries.push(format!(
+                                        "{}: the domain of {}; {}, {}",
+                                        dpath.display(),
+                                        path.display(),
+                                        report::plural(e, "error"),
+                                        report::plural(w, "warning")
+                                    ));
+                                    all_diags.extend(ddiags);
+                                }
+                                found.push((key.clone(), u));
+                            }
+                            found.iter().find(|(k, _)| *k == key).map(|(_, u)| u)
                         }
                         None => None,
                     },
@@ -119,6 +140,11 @@ pub fn run(
     } else {
         ExitCode::SUCCESS
     })
+}
+
+/// A path as the file it names, to tell two spellings of one file apart.
+fn same_file(p: &Path) -> PathBuf {
+    std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf())
 }
 
 /// The domain of a problem: `domain.pddl` or `NAME-domain.pddl` beside it,

@@ -78,7 +78,10 @@ impl Verdict {
 impl<'d> Reach<'d> {
     /// The named actions the rule is for (see [`Verdict::is_for`]).
     pub fn meant(&self) -> Vec<&(&'d Action, usize, Captures, Verdict)> {
-        self.named.iter().filter(|(_, _, _, v)| v.is_for()).collect()
+        self.named
+            .iter()
+            .filter(|(_, _, _, v)| v.is_for())
+            .collect()
     }
 
     /// Indices (in the domain) of the actions some of whose steps can match.
