@@ -351,6 +351,7 @@ pub mod codes {
         X_REPLAN_UNSOLVABLE = "X008", "a goal that replanning cannot reach after a fault";
         X_REPLAN_LIMIT = "X009", "a closed loop that stopped at its replan or tick limit";
         X_WORLD = "X010", "a JSON IR whose world is missing or does not fit together";
+        X_TRIGGER = "X011", "a fault trigger that names no action of the tree, so the fault never happens";
         X_BTLOG = "X030", "a run that a Groot2 `.btlog` file cannot hold";
         X_SCRIPT = "X040", "a BT.CPP script that does not parse";
         X_UNSUPPORTED = "X041", "a BT.CPP XML construct btc does not run";
