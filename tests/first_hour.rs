@@ -74,3 +74,35 @@ fn an_undeclared_predicate_gets_its_declaration_as_a_fix() {
         .collect();
     assert_eq!(left, ["predicate `redy` is not declared in the domain"]);
 }
+
+/// A decorator count looked up in a table that lacks the step's key:
+/// `btc check` warns (R024) for the problem's objects without a key, and
+/// the compile's R023 names the table and the key.
+#[test]
+fn a_lookup_without_the_key_names_the_table_and_the_key() {
+    let dir = fixture("diagnostics/R024");
+    let check = btc_in(&dir, &["check", "rules.btrules"]);
+    exits(&check, 0, "btc check");
+    let said = String::from_utf8_lossy(&check.stderr);
+    assert!(
+        said.contains("table `move_ms` has no key for `home`, `bin3`"),
+        "{said}"
+    );
+    let compile = btc_in(
+        &dir,
+        &[
+            "compile",
+            "rules.btrules",
+            "--plan",
+            "plan.plan",
+            "--emit",
+            "btcpp",
+        ],
+    );
+    exits(&compile, 1, "btc compile");
+    let said = String::from_utf8_lossy(&compile.stderr);
+    assert!(
+        said.contains("`timeout` gets no value: table `move_ms` has no key `bin3`"),
+        "{said}"
+    );
+}
