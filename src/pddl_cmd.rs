@@ -1,6 +1,6 @@
 //! `btc pddl FILE...`: parse and check domains and problems.
 
-use crate::{files, report, Format};
+use crate::{domain_lookup, files, report, Format};
 use btc_pddl::diagnostic::{codes, Diagnostic};
 use btc_pddl::pipeline::{domain_unit, problem_unit, DomainUnit};
 use btc_pddl::source::Sources;
@@ -57,7 +57,7 @@ pub fn run(
             Some(Document::Problem(p)) => {
                 let du = match &explicit {
                     Some(u) => Some(u),
-                    None => match find_domain(path, &p.domain.name) {
+                    None => match domain_lookup::beside(path, &p.domain.name) {
                         Some(dpath) => {
                             let key = same_file(&dpath);
                             if !found.iter().any(|(k, _)| *k == key) {
@@ -145,34 +145,4 @@ pub fn run(
 /// A path as the file it names, to tell two spellings of one file apart.
 fn same_file(p: &Path) -> PathBuf {
     std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf())
-}
-
-/// The domain of a problem: `domain.pddl` or `NAME-domain.pddl` beside it,
-/// or any `.pddl` file there that defines the named domain.
-fn find_domain(problem: &Path, name: &str) -> Option<PathBuf> {
-    let dir = problem
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let stem = problem.file_stem()?.to_string_lossy();
-    for candidate in [
-        dir.join(format!("{stem}-domain.pddl")),
-        dir.join("domain.pddl"),
-    ] {
-        if candidate.is_file() {
-            return Some(candidate);
-        }
-    }
-    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
-        .ok()?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .collect();
-    entries.sort();
-    entries.into_iter().find(|p| {
-        p.extension().is_some_and(|e| e.eq_ignore_ascii_case("pddl"))
-            && btc_files::read(p, btc_pddl::source::MAX_FILE_BYTES).is_ok_and(|bytes| {
-                let text = btc_pddl::source::decode(&bytes).0;
-                matches!(pddl::parse_document(&text, 0).0, Some(Document::Domain(d)) if d.name.name == name)
-            })
-    })
 }

@@ -1,7 +1,7 @@
 //! `btc run`: compiles a plan (or loads a tree file) and executes it with
 //! the runtime against the problem's simulated world, with injected faults.
 
-use crate::{files, paths, report, rules_cmd, Format};
+use crate::{domain_lookup, files, paths, report, rules_cmd, Format};
 use btc_lang::db;
 use btc_lang::path::FilePath;
 use btc_lang::project::PlanSource;
@@ -301,19 +301,19 @@ fn run_tree(a: &RunArgs, tree: &Path) -> anyhow::Result<ExitCode> {
             _ => unreachable!("a current IR without --problem ran above"),
         };
     };
+    let pfile = files::load(&mut sources, &problem_path, &mut diags)?;
     let domain_path = a
         .domain
         .clone()
         .or_else(|| named.as_ref().and_then(|(d, _)| recorded(d)))
-        .or_else(|| Some(problem_path.with_file_name("domain.pddl")).filter(|p| p.is_file()))
+        .or_else(|| domain_lookup::for_problem(&problem_path, sources.text(pfile)))
         .ok_or_else(|| {
             anyhow::anyhow!(
-                "no domain for `{}`: pass `--domain DOMAIN`",
+                "no domain for `{}`: none beside it (`domain.pddl`, or a `.pddl` file defining its domain); pass `--domain DOMAIN`",
                 problem_path.display()
             )
         })?;
     let dfile = files::load(&mut sources, &domain_path, &mut diags)?;
-    let pfile = files::load(&mut sources, &problem_path, &mut diags)?;
     let du = pipeline::domain_unit(&sources, dfile);
     let pu = pipeline::problem_unit(&sources, pfile, &du);
     diags.extend(du.diagnostics.iter().cloned());

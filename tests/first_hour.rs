@@ -106,3 +106,125 @@ fn a_lookup_without_the_key_names_the_table_and_the_key() {
         "{said}"
     );
 }
+
+/// The ARIAC example in a fresh folder, its domain saved as `floor.pddl`
+/// (a name `btc pddl` and `btc run --tree` find by the domain it defines).
+fn ariac_elsewhere() -> tempfile::TempDir {
+    let tmp = tempfile::tempdir().unwrap();
+    let ex = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/ariac");
+    for f in ["problem.pddl", "plan.txt"] {
+        std::fs::copy(ex.join(f), tmp.path().join(f)).unwrap();
+    }
+    std::fs::copy(ex.join("domain.pddl"), tmp.path().join("floor.pddl")).unwrap();
+    let rules = std::fs::read_to_string(ex.join("rules.btrules"))
+        .unwrap()
+        .replace("domain \"domain.pddl\"", "domain \"floor.pddl\"");
+    std::fs::write(tmp.path().join("rules.btrules"), rules).unwrap();
+    tmp
+}
+
+/// A misspelled path, in a rules file or on the command line, gets the
+/// closest file beside it; every command says F001 the same way.
+#[test]
+fn a_misspelled_path_gets_the_file_beside_it() {
+    let tmp = ariac_elsewhere();
+    let dir = tmp.path();
+    let rules = std::fs::read_to_string(dir.join("rules.btrules")).unwrap();
+    std::fs::write(
+        dir.join("typo.btrules"),
+        rules.replace("\"floor.pddl\"", "\"flor.pddl\""),
+    )
+    .unwrap();
+    let check = json_of(&btc_in(dir, &["check", "typo.btrules", "--format", "json"]));
+    let r017 = &check["diagnostics"][0];
+    assert_eq!(r017["code"], "R017", "{check:#}");
+    assert_eq!(r017["hint"], "did you mean `floor.pddl`? It is beside it");
+    assert_eq!(r017["fixes"][0]["replacement"], "\"floor.pddl\"");
+    for args in [
+        &["plan", "flor.pddl", "problem.pddl"][..],
+        &["check", "rule.btrules"],
+        &["validate", "floor.pddl", "problem.pddl", "plan.tx"],
+        &[
+            "compile",
+            "rules.btrules",
+            "--plan",
+            "plan.tx",
+            "--emit",
+            "json",
+        ],
+    ] {
+        let out = btc_in(dir, args);
+        exits(&out, 2, &args.join(" "));
+        let said = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            said.starts_with("error: [F001] cannot read `")
+                && said.contains("`: no such file; did you mean `"),
+            "{args:?}: {said}"
+        );
+    }
+}
+
+/// `-o` makes the folders it needs, for every command that writes.
+#[test]
+fn outputs_go_into_folders_that_do_not_exist_yet() {
+    let tmp = ariac_elsewhere();
+    let dir = tmp.path();
+    for args in [
+        &[
+            "compile",
+            "rules.btrules",
+            "--plan",
+            "plan.txt",
+            "--emit",
+            "btcpp",
+            "-o",
+            "out/a/tree.xml",
+        ][..],
+        &[
+            "plan",
+            "floor.pddl",
+            "problem.pddl",
+            "-q",
+            "-o",
+            "out/b/sas_plan",
+        ],
+        &[
+            "run",
+            "rules.btrules",
+            "--plan",
+            "plan.txt",
+            "--trace",
+            "out/c/trace.jsonl",
+        ],
+    ] {
+        exits(&btc_in(dir, args), 0, &args.join(" "));
+        let written = args.last().unwrap();
+        assert!(dir.join(written).is_file(), "{written}");
+    }
+}
+
+/// `btc run --tree` finds a problem's domain as `btc pddl` does: by the
+/// domain name, in the problem's folder.
+#[test]
+fn run_finds_the_domain_of_a_problem_as_pddl_does() {
+    let tmp = ariac_elsewhere();
+    let dir = tmp.path();
+    let args = [
+        "compile",
+        "rules.btrules",
+        "--plan",
+        "plan.txt",
+        "--emit",
+        "btcpp",
+        "-o",
+        "t.xml",
+    ];
+    exits(&btc_in(dir, &args), 0, "compile");
+    exits(&btc_in(dir, &["pddl", "problem.pddl"]), 0, "btc pddl");
+    let run = btc_in(
+        dir,
+        &["run", "--tree", "t.xml", "--problem", "problem.pddl"],
+    );
+    exits(&run, 0, "btc run --tree");
+    assert!(String::from_utf8_lossy(&run.stdout).contains("goal reached: yes"));
+}

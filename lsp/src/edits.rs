@@ -45,8 +45,9 @@ pub fn code_actions(
 ) -> Vec<CodeAction> {
     let ix = a.line_index();
     let file_id = btc_lang::db::file_id(&a.ws.db, a.file);
-    let diags = rules_diagnostics(&a.ws.db, a.file);
-    let mut out = quick_fixes(diags, file_id, ix, uri, range, to_lsp);
+    let mut diags = rules_diagnostics(&a.ws.db, a.file).clone();
+    btc_lang::project::suggest_paths(&a.ws.db, a.ws.loader(), a.file, &mut diags);
+    let mut out = quick_fixes(&diags, file_id, ix, uri, range, to_lsp);
     if let Some(text) = rule_stubs(a) {
         let uncovered = text.matches("\nrule (").count();
         out.push(CodeAction {
