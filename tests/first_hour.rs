@@ -228,3 +228,27 @@ fn run_finds_the_domain_of_a_problem_as_pddl_does() {
     exits(&run, 0, "btc run --tree");
     assert!(String::from_utf8_lossy(&run.stdout).contains("goal reached: yes"));
 }
+
+/// The bundled examples check clean: no diagnostic on any rules file, and
+/// none on any PDDL file (the first command of the README is one of them).
+#[test]
+fn every_example_checks_without_a_warning() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut seen = 0;
+    for e in std::fs::read_dir(root.join("examples")).unwrap() {
+        let dir = e.unwrap().path();
+        for f in std::fs::read_dir(&dir).unwrap() {
+            let f = f.unwrap().path();
+            let name = f.to_str().unwrap();
+            let args: Vec<&str> = match f.extension().and_then(|x| x.to_str()) {
+                Some("btrules") => vec!["check", name, "--format", "json"],
+                Some("pddl") => vec!["pddl", name, "--format", "json"],
+                _ => continue,
+            };
+            let v = json_of(&btc_in(root, &args));
+            assert_eq!(v["diagnostics"], serde_json::json!([]), "{name}: {v:#}");
+            seen += 1;
+        }
+    }
+    assert!(seen >= 10, "{seen} files");
+}
