@@ -252,3 +252,35 @@ fn every_example_checks_without_a_warning() {
     }
     assert!(seen >= 10, "{seen} files");
 }
+
+/// The generated py_trees module says how it builds leaf classes as the
+/// runtime does (and docs/pytrees.md says): with the step for btc's bases.
+#[test]
+fn the_pytrees_header_says_how_classes_are_built() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let out = btc_in(
+        root,
+        &[
+            "compile",
+            "examples/p3_assembler/rules.btrules",
+            "--plan",
+            "examples/p3_assembler/plan.tplan",
+            "--emit",
+            "pytrees",
+            "--node-module",
+            "p3_nodes",
+        ],
+    );
+    exits(&out, 0, "compile --emit pytrees");
+    let module = String::from_utf8_lossy(&out.stdout);
+    let header: String = module
+        .lines()
+        .take_while(|l| l.starts_with('#'))
+        .collect::<Vec<_>>()
+        .join("\n");
+    assert!(
+        header.contains("`Class(node_name, step=k, **ports)`")
+            && header.contains("as `Class(node_name, **ports)` otherwise"),
+        "{header}"
+    );
+}
