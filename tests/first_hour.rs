@@ -5,6 +5,13 @@ mod support;
 use std::path::Path;
 use support::{btc_in, exits, json_of};
 
+/// `btc ARGS` in `dir`, which must exit with `code`.
+fn run_in(dir: &Path, args: &[&str], code: i32) -> std::process::Output {
+    let out = btc_in(dir, args);
+    exits(&out, code, &args.join(" "));
+    out
+}
+
 fn fixture(dir: &str) -> std::path::PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("tests/fixtures")
@@ -81,25 +88,21 @@ fn an_undeclared_predicate_gets_its_declaration_as_a_fix() {
 #[test]
 fn a_lookup_without_the_key_names_the_table_and_the_key() {
     let dir = fixture("diagnostics/R024");
-    let check = btc_in(&dir, &["check", "rules.btrules"]);
-    exits(&check, 0, "btc check");
+    let check = run_in(&dir, &["check", "rules.btrules"], 0);
     let said = String::from_utf8_lossy(&check.stderr);
     assert!(
         said.contains("table `move_ms` has no key for `home`, `bin3`"),
         "{said}"
     );
-    let compile = btc_in(
-        &dir,
-        &[
-            "compile",
-            "rules.btrules",
-            "--plan",
-            "plan.plan",
-            "--emit",
-            "btcpp",
-        ],
-    );
-    exits(&compile, 1, "btc compile");
+    let args = [
+        "compile",
+        "rules.btrules",
+        "--plan",
+        "plan.plan",
+        "--emit",
+        "btcpp",
+    ];
+    let compile = run_in(&dir, &args, 1);
     let said = String::from_utf8_lossy(&compile.stderr);
     assert!(
         said.contains("`timeout` gets no value: table `move_ms` has no key `bin3`"),
@@ -258,20 +261,17 @@ fn every_example_checks_without_a_warning() {
 #[test]
 fn the_pytrees_header_says_how_classes_are_built() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let out = btc_in(
-        root,
-        &[
-            "compile",
-            "examples/p3_assembler/rules.btrules",
-            "--plan",
-            "examples/p3_assembler/plan.tplan",
-            "--emit",
-            "pytrees",
-            "--node-module",
-            "p3_nodes",
-        ],
-    );
-    exits(&out, 0, "compile --emit pytrees");
+    let args = [
+        "compile",
+        "examples/p3_assembler/rules.btrules",
+        "--plan",
+        "examples/p3_assembler/plan.tplan",
+        "--emit",
+        "pytrees",
+        "--node-module",
+        "p3_nodes",
+    ];
+    let out = run_in(root, &args, 0);
     let module = String::from_utf8_lossy(&out.stdout);
     let header: String = module
         .lines()
