@@ -34,13 +34,38 @@ fn read(path: &Path) -> Result<Read, btc_files::ReadError> {
     }
 }
 
-/// The command stops on a file it was given that cannot be read (exit 2).
-fn unreadable(path: &Path, e: &btc_files::ReadError) -> anyhow::Error {
-    let code = match e {
-        btc_files::ReadError::NotAFile { .. } => codes::FILE_NOT_REGULAR,
+/// The command stops on a file it was given that cannot be read (exit 2):
+/// one message for every command, F001 (F004 for a folder or a device),
+/// with the closest file beside it when it does not exist.
+fn file_error(path: &Path, why: &ReadFailure) -> anyhow::Error {
+    let code = match why {
+        ReadFailure::NotAFile { .. } => codes::FILE_NOT_REGULAR,
         _ => codes::FILE_UNREADABLE,
     };
-    anyhow::anyhow!("[{}] cannot read `{}`: {e}", code.id, path.display())
+    let mut message = format!("[{}] cannot read `{}`: {why}", code.id, path.display());
+    if *why == ReadFailure::NotFound {
+        if let Some(near) = closest_beside(path) {
+            message.push_str(&format!("; did you mean `{}`?", near.display()));
+        }
+    }
+    anyhow::anyhow!(message)
+}
+
+/// The file in `path`'s folder whose name is closest to its name.
+fn closest_beside(path: &Path) -> Option<PathBuf> {
+    let name = path.file_name()?.to_string_lossy();
+    let dir = path.parent().unwrap_or(Path::new(""));
+    let listed = list(if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    });
+    let names: Vec<String> = listed
+        .iter()
+        .filter_map(|p| Some(p.file_name()?.to_string_lossy().into_owned()))
+        .collect();
+    let best = btc_pddl::diagnostic::closest(&name, names.iter().map(String::as_str))?;
+    Some(dir.join(best))
 }
 
 /// Reads a UTF-8 file whole through the bounded reader, for readers that
@@ -130,11 +155,10 @@ pub fn list(dir: &Path) -> Vec<PathBuf> {
 
 /// A file the user named that cannot be read: the command stops (exit 2).
 pub fn unreadable_job_file(e: btc_lang::project::job::Unreadable) -> anyhow::Error {
-    let code = match e.why {
-        ReadFailure::NotAFile { .. } => codes::FILE_NOT_REGULAR,
-        _ => codes::FILE_UNREADABLE,
-    };
-    anyhow::anyhow!("[{}] {e}", code.id)
+    match e.path.as_path() {
+        Some(p) => file_error(p, &e.why),
+        None => anyhow::anyhow!("[{}] {e}", codes::FILE_UNREADABLE.id),
+    }
 }
 
 /// Writes an output file (`-o`, `fmt`): atomically for a regular file,
@@ -143,8 +167,21 @@ pub fn write_atomically(path: &Path, text: &str) -> anyhow::Result<()> {
     write_bytes_atomically(path, text.as_bytes())
 }
 
+/// Creates the missing folders above an output file: every command that
+/// writes (`-o`, `--trace`, `--btlog`, ...) does, as `btc executor -o` does
+/// for its folder. Called once the output is ready to be written, so a
+/// command that fails first creates nothing.
+fn make_parent(path: &Path) -> anyhow::Result<()> {
+    match path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() && !dir.exists() => std::fs::create_dir_all(dir)
+            .map_err(|e| anyhow::anyhow!("cannot create the folder `{}`: {e}", dir.display())),
+        _ => Ok(()),
+    }
+}
+
 /// [`write_atomically`] for bytes.
 pub fn write_bytes_atomically(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
+    make_parent(path)?;
     btc_files::write(path, bytes)
         .map_err(|e| anyhow::anyhow!("cannot write `{}`: {e}", path.display()))
 }
@@ -155,12 +192,14 @@ pub fn write_produced(
     path: &Path,
     produce: &mut btc_files::write::Produce<'_>,
 ) -> anyhow::Result<()> {
+    make_parent(path)?;
     btc_files::write_with(path, produce)
         .map_err(|e| anyhow::anyhow!("cannot write `{}`: {e}", path.display()))
 }
 
 /// Opens an output that is written as it is produced (`--trace`).
 pub fn stream(path: &Path) -> anyhow::Result<btc_files::Stream> {
+    make_parent(path)?;
     btc_files::Stream::create(path)
         .map_err(|e| anyhow::anyhow!("cannot write `{}`: {e}", path.display()))
 }
@@ -171,7 +210,7 @@ pub fn load(
     path: &Path,
     diags: &mut Vec<Diagnostic>,
 ) -> anyhow::Result<FileId> {
-    let r = read(path).map_err(|e| unreadable(path, &e))?;
+    let r = read(path).map_err(|e| file_error(path, &failure(e)))?;
     let id = sources.add(path.display().to_string(), r.text);
     if let Some(p) = r.problem {
         diags.push(decode_diagnostic(id, &p));

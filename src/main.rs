@@ -1,6 +1,7 @@
 //! `btc`: the command line. Parses arguments, reads files, calls the
 //! library and prints; nothing else lives here.
 
+mod domain_lookup;
 mod executor_cmd;
 mod files;
 mod paths;

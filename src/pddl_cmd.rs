@@ -1,6 +1,6 @@
 //! `btc pddl FILE...`: parse and check domains and problems.
 
-use crate::{files, report, Format};
+use crate::{domain_lookup, files, report, Format};
 use btc_pddl::diagnostic::{codes, Diagnostic};
 use btc_pddl::pipeline::{domain_unit, problem_unit, DomainUnit};
 use btc_pddl::source::Sources;
@@ -25,6 +25,10 @@ pub fn run(
         all_diags.extend(unit.diagnostics.iter().cloned());
         explicit = Some(unit);
     }
+    // The domains found beside problems, each loaded once; one the command
+    // line lists reports its diagnostics as its own file only.
+    let listed: Vec<PathBuf> = paths.iter().map(|p| same_file(p)).collect();
+    let mut found: Vec<(PathBuf, DomainUnit)> = Vec::new();
     for path in paths {
         let mut diags = Vec::new();
         let id = files::load(&mut sources, path, &mut diags)?;
@@ -51,16 +55,33 @@ pub fn run(
                 }
             }
             Some(Document::Problem(p)) => {
-                let found;
                 let du = match &explicit {
                     Some(u) => Some(u),
-                    None => match find_domain(path, &p.domain.name) {
+                    None => match domain_lookup::beside(path, &p.domain.name) {
                         Some(dpath) => {
-                            let did = files::load(&mut sources, &dpath, &mut diags)?;
-                            let u = domain_unit(&sources, did);
-                            diags.extend(u.diagnostics.iter().filter(|d| d.is_error()).cloned());
-                            found = u;
-                            Some(&found)
+                            let key = same_file(&dpath);
+                            if !found.iter().any(|(k, _)| *k == key) {
+                                // A domain the command line does not list is
+                                // reported here once, in its own line: its
+                                // errors are not the problem's.
+                                let mut ddiags = Vec::new();
+                                let did = files::load(&mut sources, &dpath, &mut ddiags)?;
+                                let u = domain_unit(&sources, did);
+                                if !listed.contains(&key) {
+                                    ddiags.extend(u.diagnostics.iter().cloned());
+                                    let (e, w) = report::count(&ddiags);
+                                    summaries.push(format!(
+                                        "{}: the domain of {}; {}, {}",
+                                        dpath.display(),
+                                        path.display(),
+                                        report::plural(e, "error"),
+                                        report::plural(w, "warning")
+                                    ));
+                                    all_diags.extend(ddiags);
+                                }
+                                found.push((key.clone(), u));
+                            }
+                            found.iter().find(|(k, _)| *k == key).map(|(_, u)| u)
                         }
                         None => None,
                     },
@@ -121,32 +142,7 @@ pub fn run(
     })
 }
 
-/// The domain of a problem: `domain.pddl` or `NAME-domain.pddl` beside it,
-/// or any `.pddl` file there that defines the named domain.
-fn find_domain(problem: &Path, name: &str) -> Option<PathBuf> {
-    let dir = problem
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let stem = problem.file_stem()?.to_string_lossy();
-    for candidate in [
-        dir.join(format!("{stem}-domain.pddl")),
-        dir.join("domain.pddl"),
-    ] {
-        if candidate.is_file() {
-            return Some(candidate);
-        }
-    }
-    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
-        .ok()?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .collect();
-    entries.sort();
-    entries.into_iter().find(|p| {
-        p.extension().is_some_and(|e| e.eq_ignore_ascii_case("pddl"))
-            && btc_files::read(p, btc_pddl::source::MAX_FILE_BYTES).is_ok_and(|bytes| {
-                let text = btc_pddl::source::decode(&bytes).0;
-                matches!(pddl::parse_document(&text, 0).0, Some(Document::Domain(d)) if d.name.name == name)
-            })
-    })
+/// A path as the file it names, to tell two spellings of one file apart.
+fn same_file(p: &Path) -> PathBuf {
+    std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf())
 }

@@ -38,7 +38,8 @@ fn shown(db: &Database, f: Option<SourceFile>, how: Option<project::ProblemChoic
 pub fn check(path: &Path, format: Format) -> anyhow::Result<ExitCode> {
     let mut database = Database::new();
     let rules = load_rules(&mut database, path)?;
-    let diags = project::flatten(project::project_report(&database, rules));
+    let mut diags = project::flatten(project::project_report(&database, rules));
+    project::suggest_paths(&database, &files::Disk, rules, &mut diags);
     let domain = db::domain_file(&database, rules);
     let problem = db::problem_file(&database, rules);
     let sources = database.sources();
@@ -149,6 +150,12 @@ pub fn load_job(
         .filter(|d| !(planned && d.span.file == plan_file && d.code.starts_with('L')))
         .cloned()
         .collect();
+    project::suggest_paths(
+        &database,
+        &files::Disk,
+        job.rules(&database),
+        &mut diagnostics,
+    );
     if !planned {
         for d in project::fit::plan_validation(&database, job) {
             let mut d = d.clone();

@@ -1,11 +1,11 @@
 //! `btc run`: compiles a plan (or loads a tree file) and executes it with
 //! the runtime against the problem's simulated world, with injected faults.
 
-use crate::{files, paths, report, rules_cmd, Format};
+use crate::{domain_lookup, files, paths, report, rules_cmd, Format};
 use btc_lang::db;
 use btc_lang::path::FilePath;
 use btc_lang::project::PlanSource;
-use btc_pddl::diagnostic::{codes, has_errors, Diagnostic};
+use btc_pddl::diagnostic::{codes, has_errors, Diagnostic, Severity};
 use btc_pddl::pipeline;
 use btc_pddl::source::{FileId, Sources, Span};
 use btc_pddl::state::World;
@@ -102,6 +102,23 @@ fn diagnostic(e: &LoadError, file: FileId, sources: &Sources) -> Diagnostic {
         d = d.with_hint(h.clone());
     }
     d
+}
+
+/// Prints warnings about a loaded file (a scenario's X011); their JSON.
+fn warnings(
+    found: &[LoadError],
+    file: FileId,
+    sources: &Sources,
+    format: Format,
+) -> Vec<serde_json::Value> {
+    let diags: Vec<Diagnostic> = found
+        .iter()
+        .map(|w| Diagnostic {
+            severity: Severity::Warning,
+            ..diagnostic(w, file, sources)
+        })
+        .collect();
+    report::diagnostics(&diags, sources, format)
 }
 
 fn fail(diags: &[Diagnostic], sources: &Sources, format: Format) -> anyhow::Result<ExitCode> {
@@ -284,19 +301,19 @@ fn run_tree(a: &RunArgs, tree: &Path) -> anyhow::Result<ExitCode> {
             _ => unreachable!("a current IR without --problem ran above"),
         };
     };
+    let pfile = files::load(&mut sources, &problem_path, &mut diags)?;
     let domain_path = a
         .domain
         .clone()
         .or_else(|| named.as_ref().and_then(|(d, _)| recorded(d)))
-        .or_else(|| Some(problem_path.with_file_name("domain.pddl")).filter(|p| p.is_file()))
+        .or_else(|| domain_lookup::for_problem(&problem_path, sources.text(pfile)))
         .ok_or_else(|| {
             anyhow::anyhow!(
-                "no domain for `{}`: pass `--domain DOMAIN`",
+                "no domain for `{}`: none beside it (`domain.pddl`, or a `.pddl` file defining its domain); pass `--domain DOMAIN`",
                 problem_path.display()
             )
         })?;
     let dfile = files::load(&mut sources, &domain_path, &mut diags)?;
-    let pfile = files::load(&mut sources, &problem_path, &mut diags)?;
     let du = pipeline::domain_unit(&sources, dfile);
     let pu = pipeline::problem_unit(&sources, pfile, &du);
     diags.extend(du.diagnostics.iter().cloned());
@@ -366,15 +383,21 @@ fn execute(
         Ok(e) => e,
         Err(e) => return fail(&[diagnostic(&e, tree_file, sources)], sources, a.format),
     };
+    // Warnings about the scenario (X011), in the JSON summary's `diagnostics`.
+    let mut warned = Vec::new();
     if let Some(path) = &a.faults {
         let mut diags = Vec::new();
         let f = files::load(sources, path, &mut diags)?;
         if has_errors(&diags) {
             return fail(&diags, sources, a.format);
         }
-        let added = Scenario::parse(sources.text(f)).and_then(|s| engine.add_faults(&s));
-        if let Err(e) = added {
-            return fail(&[diagnostic(&e, f, sources)], sources, a.format);
+        let added = Scenario::parse(sources.text(f)).and_then(|s| {
+            engine.add_faults(&s)?;
+            Ok(s.triggers_naming_nothing(&engine.action_ids()))
+        });
+        match added {
+            Err(e) => return fail(&[diagnostic(&e, f, sources)], sources, a.format),
+            Ok(never) => warned = warnings(&never, f, sources, a.format),
         }
     }
     if a.controller {
@@ -430,6 +453,9 @@ fn execute(
                     o.insert("commands".into(), serde_json::to_value(c)?);
                 }
                 o.insert("problem".into(), problem.into());
+                if !warned.is_empty() {
+                    o.insert("diagnostics".into(), warned.into());
+                }
             }
             if let (Some(o), Some(kb)) = (v.as_object_mut(), &engine.kb) {
                 o.insert("kb".into(), serde_json::to_value(kb.snapshot())?);
@@ -518,7 +544,19 @@ fn run_replan(a: &RunArgs, rules: &Path) -> anyhow::Result<ExitCode> {
                 return fail(&d, &scen_sources, a.format);
             }
             match Scenario::parse(scen_sources.text(f)) {
-                Ok(s) => Some((s, f)),
+                Ok(s) => {
+                    // The trees of the loop call the actions the rules declare.
+                    let decls = db::declarations(&database, job.rules(&database));
+                    let actions: Vec<&str> = decls
+                        .nodes
+                        .values()
+                        .filter(|n| n.kind == btc_lang::rules::ast::NodeKind::Action)
+                        .map(|n| n.name.text.as_str())
+                        .collect();
+                    let never = s.triggers_naming_nothing(&actions);
+                    warnings(&never, f, &scen_sources, a.format);
+                    Some((s, f))
+                }
                 Err(e) => {
                     return fail(&[diagnostic(&e, f, &scen_sources)], &scen_sources, a.format)
                 }

@@ -437,7 +437,7 @@ fn palette_written_by_btcpp_imports_and_checks(exe: &Path, work: &Path) {
         .iter()
         .map(|d| d["code"].as_str().unwrap())
         .collect();
-    assert_eq!(codes, ["P108"], "only the domain's own warning");
+    assert!(codes.is_empty(), "the example checks clean: {codes:?}");
 
     let (plan, problem) = (example.join("plan.txt"), example.join("problem.pddl"));
     let (plan, problem) = (plan.to_str().unwrap(), problem.to_str().unwrap());

@@ -1,10 +1,11 @@
 ; ARIAC 2023 floor-robot domain: Listing 1 of Liu et al., "Autonomous Robot
 ; Task Execution in Flexible Manufacturing: Integrating PDDL and Behavior
 ; Trees in ARIAC 2023", Biomimetics 9 (2024) 612.
-; As in the paper, `grasp` uses a negative precondition without declaring
-; :negative-preconditions; btc accepts it with a warning (P108).
+; One change from the listing: `:negative-preconditions` is declared,
+; because `grasp` has a negative precondition (the listing leaves it out,
+; which btc reports as warning P108). See README.md.
 (define (domain ariac_domain)
-  (:requirements :strips :typing)
+  (:requirements :strips :typing :negative-preconditions)
   (:types container part robot)
   (:predicates (attach ?part - part ?robot - robot)
     (is_enabled ?robot - robot)

@@ -869,25 +869,43 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
                 continue;
             };
             if count_in_range(v, *range).is_none() {
+                // A lookup is named with the key this step gives it.
+                let lookup =
+                    rt.params
+                        .iter()
+                        .find(|(n, _)| n == param)
+                        .and_then(|(_, e)| match e {
+                            Value::Lookup { table, key, .. } => {
+                                Some((table.text.clone(), call_inst.eval(key).to_text()))
+                            }
+                            _ => None,
+                        });
+                let (got, hint) = match (v, &lookup) {
+                    (PortValue::Text(t), Some((table, key))) if t.is_empty() => (
+                        format!("no value: table `{table}` has no key `{key}`"),
+                        format!("add `{key}: N` to table `{table}`"),
+                    ),
+                    (PortValue::Text(t), None) if t.is_empty() => (
+                        "no value".to_owned(),
+                        "a table lookup gives no value for a key the table does not have; add the key".to_owned(),
+                    ),
+                    (other, _) => (
+                        format!("`{}`, which is not a number of {} from {} to {}", other.to_text(), range.what, range.min, range.max),
+                        format!("give a number of {} from {} to {}", range.what, range.min, range.max),
+                    ),
+                };
                 diags.push(
                     Diagnostic::error(
                         codes::R_BAD_ARGUMENT,
                         step.span,
                         format!(
-                            "step {} `{}`: `{}` gets {}, which is not a number of {} from {} to {}",
+                            "step {} `{}`: `{}` gets {got}",
                             k + 1,
                             logic.display(),
                             d.keyword(),
-                            match v {
-                                PortValue::Text(t) if t.is_empty() => "no value".to_owned(),
-                                other => format!("`{}`", other.to_text()),
-                            },
-                            range.what,
-                            range.min,
-                            range.max
                         ),
                     )
-                    .with_hint("a table lookup gives no value for a key the table does not have; add the key"),
+                    .with_hint(hint),
                 );
             }
         }

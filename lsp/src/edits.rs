@@ -3,7 +3,9 @@
 
 use crate::analysis::Analysis;
 use crate::convert::LineIndex;
-use btc_lang::db::{import_closure, parsed_rules, rules_diagnostics};
+use crate::workspace::Workspace;
+use btc_lang::db::{checked_domain, import_closure, parsed_rules, rules_diagnostics};
+use btc_lang::path::FilePath;
 use btc_lang::rules::ast::Item;
 use btc_lang::rules::fmt::format_parsed;
 use btc_lang::rules::matching::match_name;
@@ -42,27 +44,10 @@ pub fn code_actions(
     to_lsp: &dyn Fn(&Diagnostic) -> tower_lsp::lsp_types::Diagnostic,
 ) -> Vec<CodeAction> {
     let ix = a.line_index();
-    let (from, to) = (ix.offset(range.start) as u32, ix.offset(range.end) as u32);
-    let mut out = Vec::new();
     let file_id = btc_lang::db::file_id(&a.ws.db, a.file);
-    for d in rules_diagnostics(&a.ws.db, a.file) {
-        if d.span.file != file_id || d.span.end < from || d.span.start > to {
-            continue;
-        }
-        for f in d.fixes.iter().filter(|f| f.span.file == file_id) {
-            out.push(CodeAction {
-                title: f.title.clone(),
-                kind: Some(CodeActionKind::QUICKFIX),
-                diagnostics: Some(vec![to_lsp(d)]),
-                edit: Some(edit(
-                    uri,
-                    vec![TextEdit::new(ix.range(f.span), f.replacement.clone())],
-                )),
-                is_preferred: Some(d.fixes.len() == 1),
-                ..CodeAction::default()
-            });
-        }
-    }
+    let mut diags = rules_diagnostics(&a.ws.db, a.file).clone();
+    btc_lang::project::suggest_paths(&a.ws.db, a.ws.loader(), a.file, &mut diags);
+    let mut out = quick_fixes(&diags, file_id, ix, uri, range, to_lsp);
     if let Some(text) = rule_stubs(a) {
         let uncovered = text.matches("\nrule (").count();
         out.push(CodeAction {
@@ -80,6 +65,57 @@ pub fn code_actions(
             )),
             ..CodeAction::default()
         });
+    }
+    out
+}
+
+/// Code actions for a range of a PDDL domain: the fixes of its own
+/// diagnostics there (P102's inferred declaration, ...).
+pub fn pddl_code_actions(
+    ws: &Workspace,
+    path: &FilePath,
+    uri: &Url,
+    range: Range,
+    to_lsp: &dyn Fn(&Diagnostic) -> tower_lsp::lsp_types::Diagnostic,
+) -> Vec<CodeAction> {
+    let Some(file) = ws.file(path) else {
+        return Vec::new();
+    };
+    let text = file.text(&ws.db);
+    let ix = &LineIndex::new(text);
+    let file_id = btc_lang::db::file_id(&ws.db, file);
+    let checked = checked_domain(&ws.db, file);
+    quick_fixes(&checked.diagnostics, file_id, ix, uri, range, to_lsp)
+}
+
+/// The fixes in this file of the diagnostics over `range`.
+fn quick_fixes(
+    diags: &[Diagnostic],
+    file_id: btc_pddl::source::FileId,
+    ix: &LineIndex,
+    uri: &Url,
+    range: Range,
+    to_lsp: &dyn Fn(&Diagnostic) -> tower_lsp::lsp_types::Diagnostic,
+) -> Vec<CodeAction> {
+    let (from, to) = (ix.offset(range.start) as u32, ix.offset(range.end) as u32);
+    let mut out = Vec::new();
+    for d in diags {
+        if d.span.file != file_id || d.span.end < from || d.span.start > to {
+            continue;
+        }
+        for f in d.fixes.iter().filter(|f| f.span.file == file_id) {
+            out.push(CodeAction {
+                title: f.title.clone(),
+                kind: Some(CodeActionKind::QUICKFIX),
+                diagnostics: Some(vec![to_lsp(d)]),
+                edit: Some(edit(
+                    uri,
+                    vec![TextEdit::new(ix.range(f.span), f.replacement.clone())],
+                )),
+                is_preferred: Some(d.fixes.len() == 1),
+                ..CodeAction::default()
+            });
+        }
     }
     out
 }

@@ -447,6 +447,20 @@ impl LanguageServer for Backend {
 
     async fn code_action(&self, p: CodeActionParams) -> Result<Option<CodeActionResponse>> {
         let uri = p.text_document.uri.clone();
+        if let Some(path) = path_of(&uri).filter(|p| p.has_extension("pddl")) {
+            return isolated(|| {
+                let ws = self.ws();
+                let text = ws.text(&path)?;
+                let lines = Lines::new(&ws, LineIndex::new(text));
+                let conv = |d: &Diagnostic| to_lsp(&lines, d);
+                Some(
+                    edits::pddl_code_actions(&ws, &path, &uri, p.range, &conv)
+                        .into_iter()
+                        .map(CodeActionOrCommand::CodeAction)
+                        .collect(),
+                )
+            });
+        }
         self.with_analysis(&p.text_document.uri, |a| {
             let lines = Lines::new(a.ws, LineIndex::new(a.text));
             let conv = |d: &Diagnostic| to_lsp(&lines, d);

@@ -98,6 +98,11 @@ impl Workspace {
         }
     }
 
+    /// Where files not open in the editor come from.
+    pub fn loader(&self) -> &dyn FileLoader {
+        self.loader.as_ref()
+    }
+
     pub fn file(&self, path: &FilePath) -> Option<SourceFile> {
         self.db.file(path)
     }
@@ -227,7 +232,11 @@ impl Workspace {
                 by_path
                     .entry(section.file.path(&self.db).clone())
                     .or_default();
-                for d in &section.diagnostics {
+                let mut diags = section.diagnostics.clone();
+                if root {
+                    project::suggest_paths(&self.db, self.loader.as_ref(), r, &mut diags);
+                }
+                for d in &diags {
                     if let Some(p) = ids.get(&d.span.file) {
                         by_path.entry(p.clone()).or_default().push(d.clone());
                     }

@@ -432,3 +432,25 @@ async fn a_domain_edited_in_the_editor_rechecks_the_rules_and_reports_its_own_er
     .await;
     assert!(c.diagnostics_for(&u).await.is_empty());
 }
+
+#[tokio::test]
+async fn an_undeclared_predicate_is_declared_by_its_quick_fix() {
+    let mut c = TestClient::new().await;
+    let domain = fixture("ariac/domain.pddl");
+    let declared = text_of(&domain);
+    let text = declared.replace("\n    (flip_on ?part - part ?container - container)", "");
+    assert_ne!(text, declared);
+    let ud = c.open_text(&domain, &text).await;
+    let diags = c.diagnostics_for(&ud).await;
+    let p102 = diags.iter().find(|d| d["code"] == "P102").unwrap();
+    let fixed = code_action(
+        &mut c,
+        &ud,
+        &text,
+        p102["range"].clone(),
+        json!([]),
+        "declare `(flip_on ?part - part ?container - container)`",
+    )
+    .await;
+    assert_eq!(fixed, declared);
+}

@@ -1,6 +1,8 @@
 //! Semantic checks of domains and problems, and the symbol tables that every
 //! later stage (plan typing, validation, rule checking) looks names up in.
 
+mod inferred;
+
 use super::ast::*;
 use super::types::{TypeId, TypeTable};
 use crate::diagnostic::{codes, did_you_mean, Diagnostic};
@@ -764,12 +766,24 @@ impl Checker<'_> {
                         atom.pred.name
                     ),
                 );
+                let decl = inferred::declaration(
+                    atom,
+                    scope,
+                    self.index,
+                    self.problem,
+                    !self.domain.types.is_empty(),
+                );
                 let hint = did_you_mean(
                     &atom.pred.name,
                     self.index.predicates.keys().map(String::as_str),
                 )
-                .unwrap_or_else(|| "declare it in `(:predicates ...)`".into());
-                self.diags.push(d.with_hint(hint));
+                .unwrap_or_else(|| format!("declare it in `(:predicates ...)`: `{decl}`"));
+                let d = d.with_hint(hint);
+                self.diags
+                    .push(match inferred::insertion(self.domain, &decl) {
+                        Some((at, text)) => d.with_fix(format!("declare `{decl}`"), at, text),
+                        None => d,
+                    });
                 for a in &atom.args {
                     self.term(a, scope);
                 }

@@ -321,6 +321,7 @@ pub mod codes {
         R_UNKNOWN_TYPE = "R021", "a port type that is neither a PDDL type nor a basic type";
         R_PLAN_BLOCK = "R022", "a `plan` block that is missing, repeated or has no `steps`";
         R_BAD_ARGUMENT = "R023", "a control or decorator argument that makes no sense";
+        R_LOOKUP_OBJECT = "R024", "a table lookup by a variable, with no key for an object of the problem the variable can stand for";
         R_EFFECT_UNBOUND = "R033", "a rule effect that reads an optional parameter a step leaves out";
         R_BACKCHAIN = "R034", "a plan `steps backchained` cannot regress its goal through";
         // .btrules: rules that no step can match, and skips that lose effects
@@ -351,6 +352,7 @@ pub mod codes {
         X_REPLAN_UNSOLVABLE = "X008", "a goal that replanning cannot reach after a fault";
         X_REPLAN_LIMIT = "X009", "a closed loop that stopped at its replan or tick limit";
         X_WORLD = "X010", "a JSON IR whose world is missing or does not fit together";
+        X_TRIGGER = "X011", "a fault trigger that names no action of the tree, so the fault never happens";
         X_BTLOG = "X030", "a run that a Groot2 `.btlog` file cannot hold";
         X_SCRIPT = "X040", "a BT.CPP script that does not parse";
         X_UNSUPPORTED = "X041", "a BT.CPP XML construct btc does not run";

@@ -60,7 +60,12 @@ pub enum Trigger {
     /// When plan step N (0-based here) starts.
     Step(usize),
     /// When an action leaf with this ID starts for the `occurrence`-th time.
-    Action { id: String, occurrence: u32 },
+    /// `at`: where the ID is written in the scenario file (a byte offset).
+    Action {
+        id: String,
+        occurrence: u32,
+        at: Option<usize>,
+    },
 }
 
 /// What a blackout makes conditions return.
@@ -113,7 +118,7 @@ struct FileFault {
     name: Option<String>,
     at_tick: Option<u64>,
     on_step: Option<usize>,
-    on_action: Option<String>,
+    on_action: Option<toml::Spanned<String>>,
     occurrence: Option<u32>,
     robot: Option<String>,
     part: Option<String>,
@@ -154,6 +159,40 @@ impl Scenario {
         })
     }
 
+    /// A warning (X011) for each `on_action` that names none of `actions`
+    /// (the action IDs of the tree the scenario runs on): such a fault can
+    /// never happen.
+    pub fn triggers_naming_nothing(&self, actions: &[&str]) -> Vec<LoadError> {
+        let mut out = Vec::new();
+        for f in &self.faults {
+            let Trigger::Action { id, at, .. } = &f.trigger else {
+                continue;
+            };
+            if actions.contains(&id.as_str()) {
+                continue;
+            }
+            let hint = btc_pddl::diagnostic::did_you_mean(id, actions.iter().copied())
+                .unwrap_or_else(|| {
+                    let mut names = actions.to_vec();
+                    names.sort_unstable();
+                    names.dedup();
+                    format!("the tree's actions are {}", names.join(", "))
+                });
+            out.push(
+                LoadError::new(
+                    codes::X_TRIGGER,
+                    format!(
+                        "fault `{}`: `on_action = \"{id}\"` names no action of the tree, so it never happens",
+                        f.label()
+                    ),
+                )
+                .hint(hint)
+                .at_opt(*at),
+            );
+        }
+        out
+    }
+
     fn fault(k: usize, f: FileFault, faults: &mut Vec<FaultSpec>) -> Result<(), LoadError> {
         {
             let kind_name = f.kind.get_ref().clone();
@@ -175,7 +214,8 @@ impl Scenario {
                 (Some(t), None, None) if t >= 1 => Trigger::Tick(t),
                 (None, Some(s), None) if s >= 1 => Trigger::Step(s - 1),
                 (None, None, Some(a)) => Trigger::Action {
-                    id: a,
+                    at: Some(a.span().start),
+                    id: a.into_inner(),
                     occurrence: f.occurrence.unwrap_or(1).max(1),
                 },
                 (Some(0), None, None) | (None, Some(0), None) => {

@@ -172,7 +172,9 @@ impl<'a> Emitter<'a, '_> {
                 let _ = writeln!(
                     o,
                     "#\n# Leaf behaviours come from the module {}: each class in\n\
-                     # NODE_CLASS_NAMES is constructed as `Class(node_name, **ports)`.",
+                     # NODE_CLASS_NAMES is constructed as `Class(node_name, step=k, **ports)`\n\
+                     # (k: its plan step) when it derives from btc_runtime's Action,\n\
+                     # Condition, KbHolds or KbApply, as `Class(node_name, **ports)` otherwise.",
                     py_str(m)
                 );
             }

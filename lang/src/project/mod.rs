@@ -8,11 +8,13 @@ pub mod fit;
 pub mod job;
 pub mod load;
 pub mod loader;
+pub mod nearby;
 pub mod refs;
 pub mod report;
 
 pub use job::{load_job, JobPaths, LoadedJob, PlanSource, ProblemChoice};
 pub use load::{load_file, load_references, load_rules, read_file};
 pub use loader::{FileLoader, Loaded, MemoryLoader, ReadFailure};
+pub use nearby::suggest_paths;
 pub use refs::{references, RefKind, Reference};
 pub use report::{flatten, job_report, project_report, FileReport};

@@ -558,6 +558,50 @@ impl Tcx<'_> {
         }
     }
 
+    /// R024: with the problem known, the objects a `?variable` key can
+    /// stand for (by its type) that the table has no key for; the compile
+    /// of a plan that reaches one of them fails, or leaves the port empty.
+    fn objects_without_key(&mut self, t: &TableDecl, var: &Ident, span: Span) {
+        let Some(c) = self.ctx else { return };
+        let Some(problem) = c.problem else { return };
+        let Some(Some(types)) = self
+            .vars
+            .iter()
+            .find(|(v, _)| *v == var.text)
+            .map(|(_, t)| t.clone())
+        else {
+            return;
+        };
+        let missing: Vec<&str> = problem
+            .objects_of(&c.index.types, &types)
+            .into_iter()
+            .map(|i| problem.object_names[i as usize].as_str())
+            .filter(|o| !t.entries.iter().any(|e| e.key.key == Key::new(o)))
+            .collect();
+        let Some(first) = missing.first() else { return };
+        let shown: Vec<String> = missing.iter().take(5).map(|o| format!("`{o}`")).collect();
+        let more = match missing.len() {
+            n if n > 5 => format!(" and {} more", n - 5),
+            _ => String::new(),
+        };
+        self.err(
+            Diagnostic::warning(
+                codes::R_LOOKUP_OBJECT,
+                span,
+                format!(
+                    "table `{}` has no key for {}{more}, which `?{}` can stand for in the problem",
+                    t.name.text,
+                    shown.join(", "),
+                    var.text
+                ),
+            )
+            .with_hint(format!(
+                "add `{first}: ...` to table `{}`; a step with such an object gets no value",
+                t.name.text
+            )),
+        );
+    }
+
     fn lookup(&mut self, table: &Ident, key: &Value, span: Span) -> VType {
         let Some(t) = self.decls.tables.get(&table.text).cloned() else {
             let candidate = closest(&table.text, self.decls.tables.keys().map(String::as_str))
@@ -609,6 +653,10 @@ impl Tcx<'_> {
                         .with_hint(format!("its keys are {}", keys())),
                     );
                 }
+            }
+            Value::Var { name } => {
+                self.value(key);
+                self.objects_without_key(&t, name, span);
             }
             other => {
                 self.value(other);
@@ -995,11 +1043,7 @@ pub fn rule_var_types(r: &Rule, decls: &Decls, ctx: Option<DomainCtx>) -> Vec<Va
     }
     let Some(c) = ctx else { return out };
     let reach = reach(r, decls, c);
-    let through_tables: Vec<_> = reach
-        .named
-        .iter()
-        .filter(|(_, _, _, v)| *v != Verdict::NotInTable)
-        .collect();
+    let through_tables = reach.meant();
     for action in typing_actions(&through_tables) {
         for v in &mut out {
             // The parameter at the variable's first position.
@@ -1072,11 +1116,7 @@ fn check_rule(r: &Rule, decls: &Decls, ctx: Option<DomainCtx>) -> Vec<Diagnostic
         return diags; // a pattern that did not parse: reported
     }
     let reach = reach(r, decls, c);
-    let through_tables: Vec<_> = reach
-        .named
-        .iter()
-        .filter(|(_, _, _, v)| *v != Verdict::NotInTable)
-        .collect();
+    let through_tables = reach.meant();
     if through_tables.is_empty() {
         let written = r.pattern.name_text();
         let candidate = closest(

@@ -130,10 +130,7 @@ pub fn rule_facts(r: &Rule, decls: &Decls, ctx: DomainCtx) -> RuleFacts {
         return RuleFacts::default();
     }
     let reach = reach(r, decls, ctx);
-    let named = reach
-        .named
-        .iter()
-        .any(|(_, _, _, v)| *v != Verdict::NotInTable);
+    let named = reach.named.iter().any(|(_, _, _, v)| v.is_for());
     let mut meant: Vec<usize> = reach
         .named
         .iter()

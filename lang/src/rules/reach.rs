@@ -54,14 +54,36 @@ pub struct Reach<'d> {
 pub enum Verdict {
     /// Some step of the action can match.
     Can,
-    /// The pattern's parameters do not fit the action's (R003).
+    /// The pattern's parameters do not fit the action's (R003): a literal
+    /// name, or a pattern with captures that fits none of the actions it
+    /// names.
     Arity,
+    /// A pattern with captures names the action, but its parameter count
+    /// fits only others of the actions it names: the rule is for those.
+    OtherCount,
     /// A `capture in table` guard leaves the action out.
     NotInTable,
     Never(Never),
 }
 
-impl Reach<'_> {
+impl Verdict {
+    /// Whether the rule is for the action at all: its `capture in table`
+    /// guards let it through and, for a pattern with captures, its
+    /// parameter count is not one only other named actions fit.
+    pub fn is_for(&self) -> bool {
+        !matches!(self, Verdict::NotInTable | Verdict::OtherCount)
+    }
+}
+
+impl<'d> Reach<'d> {
+    /// The named actions the rule is for (see [`Verdict::is_for`]).
+    pub fn meant(&self) -> Vec<&(&'d Action, usize, Captures, Verdict)> {
+        self.named
+            .iter()
+            .filter(|(_, _, _, v)| v.is_for())
+            .collect()
+    }
+
     /// Indices (in the domain) of the actions some of whose steps can match.
     pub fn actions(&self) -> Vec<usize> {
         self.named
@@ -82,7 +104,10 @@ impl Reach<'_> {
         self.named
             .iter()
             .all(|(_, _, _, v)| {
-                matches!(v, Verdict::Never(_) | Verdict::Arity | Verdict::NotInTable)
+                matches!(
+                    v,
+                    Verdict::Never(_) | Verdict::Arity | Verdict::OtherCount | Verdict::NotInTable
+                )
             })
             .then_some(first)
     }
@@ -98,7 +123,7 @@ pub fn matches_every_step(r: &Rule) -> bool {
 }
 
 pub fn reach<'d>(r: &Rule, decls: &Decls, ctx: DomainCtx<'d>) -> Reach<'d> {
-    let named = ctx
+    let mut named: Vec<_> = ctx
         .actions
         .matches(&r.pattern.name, ctx.domain)
         .into_iter()
@@ -118,6 +143,25 @@ pub fn reach<'d>(r: &Rule, decls: &Decls, ctx: DomainCtx<'d>) -> Reach<'d> {
             (a, i, caps, verdict)
         })
         .collect();
+    // The docs' promise: a pattern with captures matches the actions it
+    // names whose parameter count it fits (`{verb}-truck ?a ?b ?c` is for
+    // the three-parameter truck actions); the count is an error only when
+    // it fits none of them, or when the name is literal.
+    let captures = r
+        .pattern
+        .name
+        .iter()
+        .any(|p| !matches!(p, super::ast::NamePart::Lit { .. }));
+    let some_fit = named
+        .iter()
+        .any(|(_, _, _, v)| !matches!(v, Verdict::Arity | Verdict::NotInTable));
+    if captures && some_fit {
+        for (_, _, _, v) in &mut named {
+            if *v == Verdict::Arity {
+                *v = Verdict::OtherCount;
+            }
+        }
+    }
     Reach { named }
 }
 

@@ -263,7 +263,7 @@ impl<'w> Engine<'w> {
         if fresh {
             for f in 0..self.faults.len() {
                 let fire = match &self.faults[f].spec.trigger {
-                    Trigger::Action { id, occurrence }
+                    Trigger::Action { id, occurrence, .. }
                         if self.faults[f].met_at.is_none()
                             && **id == *self.actions[a as usize].id =>
                     {

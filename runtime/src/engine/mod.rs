@@ -263,6 +263,15 @@ impl<'w> Engine<'w> {
         self.bb.get(i)
     }
 
+    /// The IDs of the tree's action leaves (what a fault's `on_action`
+    /// can name), each once.
+    pub fn action_ids(&self) -> Vec<&str> {
+        let mut ids: Vec<&str> = self.actions.iter().map(|a| &*a.id).collect();
+        ids.sort_unstable();
+        ids.dedup();
+        ids
+    }
+
     pub fn steps_total(&self) -> usize {
         self.steps.iter().filter(|s| !s.skipped).count()
     }
