@@ -9,6 +9,7 @@ use serde::Serialize;
 
 mod ground;
 mod interference;
+pub mod schedule;
 mod step;
 mod timed;
 mod tracked;
