@@ -102,7 +102,10 @@ struct Ready<'a> {
     event: Event,
     action: Step<'a>,
     duration: Option<f64>,
-    footprint: Footprint,
+    /// What it reads and writes, worked out only when the happening has
+    /// other events it could interfere with (a long sequential plan has
+    /// one event per happening).
+    footprint: Option<Footprint>,
 }
 
 impl<'a> TimedReplay<'a> {
@@ -167,6 +170,7 @@ impl<'a> TimedReplay<'a> {
     fn apply_happening(&mut self, now: f64, events: Vec<Event>) -> Result<(), Diagnostic> {
         let world = self.world;
         let mut ready = Vec::with_capacity(events.len());
+        let concurrent = events.len() > 1;
         for mut event in events {
             let g = &self.steps[event.step];
             let action = self.actions.get(g.action)?;
@@ -181,7 +185,8 @@ impl<'a> TimedReplay<'a> {
                 Phase::End => (&c.pre_end, &c.eff_end),
                 Phase::Instant => (&c.pre_start, &c.eff_end),
             };
-            let footprint = Footprint::of(world, &self.state, conds, effects, &mut b, duration);
+            let footprint = concurrent
+                .then(|| Footprint::of(world, &self.state, conds, effects, &mut b, duration));
             ready.push(Ready {
                 event,
                 action,
@@ -253,7 +258,10 @@ impl<'a> TimedReplay<'a> {
     fn check_interference(&self, now: f64, ready: &[Ready]) -> Result<(), Diagnostic> {
         for (i, a) in ready.iter().enumerate() {
             for b in &ready[i + 1..] {
-                let Some(clash) = a.footprint.clash(&b.footprint, self.world) else {
+                let (Some(fa), Some(fb)) = (&a.footprint, &b.footprint) else {
+                    continue;
+                };
+                let Some(clash) = fa.clash(fb, self.world) else {
                     continue;
                 };
                 let other = self.describe(b);
@@ -361,7 +369,11 @@ impl<'a> TimedReplay<'a> {
                 );
                 let culprit = ready
                     .iter()
-                    .find(|e| e.footprint.changes_any(&reads))
+                    .find(|e| match &e.footprint {
+                        Some(f) => f.changes_any(&reads),
+                        // The happening's only event: it broke it.
+                        None => true,
+                    })
                     .map(|e| format!(" after {}", self.describe(e)))
                     .unwrap_or_default();
                 let event = Event {
