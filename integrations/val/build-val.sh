@@ -15,33 +15,10 @@ set -euo pipefail
 
 repo=$(cd "$(dirname "$0")/../.." && pwd)
 archive=${1:-${BTC_VAL_ARCHIVE:-$repo/../shared/vendor/VAL-3c7a1f3.tar.gz}}
-if [ ! -f "$archive" ]; then
-  echo "error: no VAL archive at $archive" >&2
-  exit 2
-fi
-for tool in cmake make c++ sha256sum flock; do
-  if ! command -v "$tool" >/dev/null 2>&1; then
-    echo "error: \`$tool\` is not installed (apt-get install cmake g++ util-linux)" >&2
-    exit 2
-  fi
-done
+# shellcheck source=../cached-build.sh
+. "$repo/integrations/cached-build.sh"
+cached_build val "$archive" /bin/Validate
 
-sha=$(sha256sum "$archive" | cut -d' ' -f1)
-cache=${XDG_CACHE_HOME:-$HOME/.cache}/btc
-prefix=$cache/val-$sha
-mkdir -p "$cache"
-
-# One build at a time per archive: tests running in parallel wait for the
-# first one instead of building side by side.
-exec 9>"$prefix.lock"
-flock 9
-
-if [ -f "$prefix/.btc-complete" ]; then
-  echo "$prefix/bin/Validate"
-  exit 0
-fi
-
-rm -rf "$prefix"
 work=$(mktemp -d "$cache/val-build.XXXXXX")
 trap 'rm -rf "$work"' EXIT
 
@@ -53,10 +30,9 @@ jobs=${BTC_BUILD_JOBS:-2}
   cmake -S "$src" -B "$work/build" -DCMAKE_BUILD_TYPE=Release
   cmake --build "$work/build" -j"$jobs" --target Validate
 } >&2
-# `Validate` finds libVAL.so beside it (its rpath is the build folder, so
-# both move together and the rpath is set to the binary's own folder).
+# `Validate` finds libVAL.so beside it (its runpath is `$ORIGIN`).
 mkdir -p "$prefix/bin"
 cp "$work/build/bin/Validate" "$prefix/bin/"
 find "$work/build" -name 'libVAL.so*' -exec cp -P {} "$prefix/bin/" \;
-echo "$sha" >"$prefix/.btc-complete"
+echo "$archive_sha" >"$prefix/.btc-complete"
 echo "$prefix/bin/Validate"

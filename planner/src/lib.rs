@@ -209,17 +209,19 @@ pub fn to_sas_plan(domain: &Domain, pix: &ProblemIndex, plan: &Plan) -> String {
         }
         out.push_str(")\n");
     }
-    let total = plan.base_cost + plan.cost as f64;
-    out.push_str(&format!(
-        "; cost = {} ({})\n",
-        total,
-        if plan.unit_cost {
-            "unit cost"
-        } else {
-            "general cost"
-        }
-    ));
+    out.push_str(&cost_line(plan));
     out
+}
+
+/// `; cost = N (unit cost|general cost)`, a plan file's last line.
+fn cost_line(plan: &Plan) -> String {
+    let total = plan.base_cost + plan.cost as f64;
+    let kind = if plan.unit_cost {
+        "unit cost"
+    } else {
+        "general cost"
+    };
+    format!("; cost = {total} ({kind})\n")
 }
 
 /// A durative domain's plan as a temporal planner writes it: one
@@ -249,16 +251,7 @@ pub fn to_timed_plan(
         "; makespan = {:.3} (the steps one after another: {:.3})\n",
         schedule.makespan, schedule.sequential
     ));
-    let total = plan.base_cost + plan.cost as f64;
-    out.push_str(&format!(
-        "; cost = {} ({})\n",
-        total,
-        if plan.unit_cost {
-            "unit cost"
-        } else {
-            "general cost"
-        }
-    ));
+    out.push_str(&cost_line(plan));
     out
 }
 
