@@ -149,6 +149,11 @@ enum Command {
         domain: PathBuf,
         problem: PathBuf,
         plan: PathBuf,
+        /// A timed plan's separation tolerance: events less than a tenth of
+        /// it apart are simultaneous, and durations must match within it
+        /// (as VAL's `-t`).
+        #[arg(short = 't', long, value_name = "SECONDS", default_value_t = btc_pddl::validate::DEFAULT_EPSILON)]
+        epsilon: f64,
         #[arg(long, value_enum, default_value_t)]
         format: Format,
     },
@@ -344,8 +349,9 @@ fn main() -> ExitCode {
             domain,
             problem,
             plan,
+            epsilon,
             format,
-        } => validate_cmd::run(&domain, &problem, &plan, format),
+        } => validate_cmd::run(&domain, &problem, &plan, epsilon, format),
         Command::Plan {
             domain,
             problem,

@@ -4,7 +4,7 @@ use crate::{files, report, Format};
 use btc_lang::project::FileLoader;
 use btc_pddl::diagnostic::has_errors;
 use btc_pddl::pipeline::{
-    domain_unit, plan_unit, problem_unit, validate_units, DomainUnit, PlanUnit, ProblemUnit,
+    domain_unit, plan_unit, problem_unit, validate_units_with, DomainUnit, PlanUnit, ProblemUnit,
 };
 use btc_pddl::plan::fit::fold_unknown_objects;
 use btc_pddl::plan::NameFit;
@@ -51,7 +51,16 @@ fn fold_misfit(
 }
 use std::process::ExitCode;
 
-pub fn run(domain: &Path, problem: &Path, plan: &Path, format: Format) -> anyhow::Result<ExitCode> {
+pub fn run(
+    domain: &Path,
+    problem: &Path,
+    plan: &Path,
+    epsilon: f64,
+    format: Format,
+) -> anyhow::Result<ExitCode> {
+    if !(epsilon.is_finite() && epsilon > 0.0) {
+        anyhow::bail!("--epsilon must be a positive number of seconds, not {epsilon}");
+    }
     let mut sources = Sources::new();
     let mut diags = Vec::new();
     let d = files::load(&mut sources, domain, &mut diags)?;
@@ -67,7 +76,7 @@ pub fn run(domain: &Path, problem: &Path, plan: &Path, format: Format) -> anyhow
     let validation = if has_errors(&diags) {
         None
     } else {
-        validate_units(&du, &pu, &lu)
+        validate_units_with(&du, &pu, &lu, epsilon)
     };
     if let Some(v) = &validation {
         diags.extend(v.diagnostics.iter().cloned());

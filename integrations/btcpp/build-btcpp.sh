@@ -13,33 +13,10 @@ set -euo pipefail
 
 repo=$(cd "$(dirname "$0")/../.." && pwd)
 archive=${1:-${BTC_BTCPP_ARCHIVE:-$repo/../shared/vendor/BehaviorTree.CPP-4.10.0.tar.gz}}
-if [ ! -f "$archive" ]; then
-  echo "error: no BehaviorTree.CPP archive at $archive" >&2
-  exit 2
-fi
-for tool in cmake make c++ sha256sum flock; do
-  if ! command -v "$tool" >/dev/null 2>&1; then
-    echo "error: \`$tool\` is not installed (apt-get install cmake g++ util-linux)" >&2
-    exit 2
-  fi
-done
+# shellcheck source=../cached-build.sh
+. "$repo/integrations/cached-build.sh"
+cached_build btcpp "$archive" ""
 
-sha=$(sha256sum "$archive" | cut -d' ' -f1)
-cache=${XDG_CACHE_HOME:-$HOME/.cache}/btc
-prefix=$cache/btcpp-$sha
-mkdir -p "$cache"
-
-# One build at a time per archive: tests running in parallel wait for the
-# first one instead of building side by side.
-exec 9>"$prefix.lock"
-flock 9
-
-if [ -f "$prefix/.btc-complete" ]; then
-  echo "$prefix"
-  exit 0
-fi
-
-rm -rf "$prefix"
 work=$(mktemp -d "$cache/btcpp-build.XXXXXX")
 trap 'rm -rf "$work"' EXIT
 
@@ -59,5 +36,5 @@ jobs=${BTC_BUILD_JOBS:-2}
   mkdir -p "$prefix/include/btc-tinyxml2"
   cp "$src/3rdparty/tinyxml2/tinyxml2.h" "$prefix/include/btc-tinyxml2/"
 } >&2
-echo "$sha" >"$prefix/.btc-complete"
+echo "$archive_sha" >"$prefix/.btc-complete"
 echo "$prefix"

@@ -292,6 +292,10 @@ pub mod codes {
         GOAL_NOT_REACHED = "V002", "a plan that does not reach the goal";
         COST_MISMATCH = "V003", "a plan whose stated cost differs from its computed cost";
         EFFECT_CONFLICT = "V004", "a numeric effect that cannot be computed";
+        DURATION_NOT_ALLOWED = "V005", "a timed step whose duration its action's `:duration` does not allow";
+        INTERFERENCE = "V006", "two events at the same time that interfere (a mutex)";
+        OVER_ALL_BROKEN = "V007", "an `over all` condition broken while its action runs";
+        UNTIMED_PLAN = "V008", "a plan without times for a domain with durative actions";
         // Planning
         PLAN_UNSUPPORTED = "S001", "a PDDL feature the planner does not support";
         PLAN_COST = "S002", "an action cost the planner cannot compute";

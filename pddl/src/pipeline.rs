@@ -6,7 +6,7 @@ use crate::diagnostic::{has_errors, Diagnostic};
 use crate::plan::{self, GroundStep, Plan};
 use crate::source::{FileId, Sources};
 use crate::state::World;
-use crate::validate::{validate, Replay, Validation};
+use crate::validate::{validate_with, Replay, Validation};
 use crate::{ast::Domain, ast::Problem, DomainIndex, ProblemIndex};
 
 pub struct DomainUnit {
@@ -112,6 +112,16 @@ pub fn validate_units(
     problem: &ProblemUnit,
     plan: &PlanUnit,
 ) -> Option<Validation> {
+    validate_units_with(domain, problem, plan, crate::validate::DEFAULT_EPSILON)
+}
+
+/// [`validate_units`] with a timed plan's separation tolerance.
+pub fn validate_units_with(
+    domain: &DomainUnit,
+    problem: &ProblemUnit,
+    plan: &PlanUnit,
+    epsilon: f64,
+) -> Option<Validation> {
     if has_errors(&domain.diagnostics)
         || has_errors(&problem.diagnostics)
         || has_errors(&plan.diagnostics)
@@ -121,12 +131,13 @@ pub fn validate_units(
     let (d, p) = (domain.domain.as_ref()?, problem.problem.as_ref()?);
     // A checked, error-free domain and problem always make a world.
     let world = World::of_checked(d, &domain.index, p, &problem.index).ok()?;
-    Some(validate(
+    Some(validate_with(
         Replay::Cached,
         &world,
         d,
         p,
         &plan.plan,
         &plan.steps,
+        epsilon,
     ))
 }

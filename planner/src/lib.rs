@@ -209,16 +209,49 @@ pub fn to_sas_plan(domain: &Domain, pix: &ProblemIndex, plan: &Plan) -> String {
         }
         out.push_str(")\n");
     }
+    out.push_str(&cost_line(plan));
+    out
+}
+
+/// `; cost = N (unit cost|general cost)`, a plan file's last line.
+fn cost_line(plan: &Plan) -> String {
     let total = plan.base_cost + plan.cost as f64;
-    out.push_str(&format!(
-        "; cost = {} ({})\n",
-        total,
-        if plan.unit_cost {
-            "unit cost"
-        } else {
-            "general cost"
+    let kind = if plan.unit_cost {
+        "unit cost"
+    } else {
+        "general cost"
+    };
+    format!("; cost = {total} ({kind})\n")
+}
+
+/// A durative domain's plan as a temporal planner writes it: one
+/// `start: (action args) [duration]` per line, in time order, then the
+/// makespan and the cost. `schedule` gives each step's start and duration
+/// (see [`btc_pddl::validate::schedule`]).
+pub fn to_timed_plan(
+    domain: &Domain,
+    pix: &ProblemIndex,
+    plan: &Plan,
+    schedule: &btc_pddl::validate::schedule::Schedule,
+) -> String {
+    let mut order: Vec<usize> = (0..plan.steps.len()).collect();
+    order.sort_by(|&a, &b| schedule.starts[a].total_cmp(&schedule.starts[b]));
+    let mut out = String::new();
+    for i in order {
+        let s = &plan.steps[i];
+        out.push_str(&format!("{:.3}: (", schedule.starts[i]));
+        out.push_str(&domain.actions[s.action].name.name);
+        for &a in &s.args {
+            out.push(' ');
+            out.push_str(&pix.object_names[a as usize]);
         }
+        out.push_str(&format!(") [{:.3}]\n", schedule.durations[i]));
+    }
+    out.push_str(&format!(
+        "; makespan = {:.3} (the steps one after another: {:.3})\n",
+        schedule.makespan, schedule.sequential
     ));
+    out.push_str(&cost_line(plan));
     out
 }
 

@@ -63,7 +63,7 @@ fn the_ariac_part_task_is_the_four_step_plan() {
 }
 
 #[test]
-fn the_p3_durative_domain_is_planned_sequentially() {
+fn the_p3_durative_domain_is_planned_and_scheduled() {
     let (d, p) = example("p3_assembler");
     let mut l = load(&d, &p);
     let (text, _, _) = l.solve_and_validate(&Options::default());

@@ -257,30 +257,7 @@ pub fn btcpp() -> Option<PathBuf> {
                 ))
             };
         }
-        let archive = btcpp_archive();
-        if !archive.is_file() {
-            return Err(format!("{} is not there", archive.display()));
-        }
-        if Command::new("cmake").arg("--version").output().is_err() {
-            return Err("cmake is not installed (`apt-get install cmake`)".into());
-        }
-        let script = repo().join("integrations/btcpp/build-btcpp.sh");
-        let out = Command::new("bash")
-            .arg(&script)
-            .arg(&archive)
-            .output()
-            .map_err(|e| format!("{} does not run: {e}", script.display()))?;
-        if !out.status.success() {
-            let err = String::from_utf8_lossy(&out.stderr);
-            let tail: Vec<&str> = err.lines().rev().take(15).collect();
-            return Err(format!(
-                "building it failed:\n{}",
-                tail.into_iter().rev().collect::<Vec<_>>().join("\n")
-            ));
-        }
-        let stdout = String::from_utf8_lossy(&out.stdout);
-        let prefix = stdout.lines().last().unwrap_or("").trim();
-        Ok(PathBuf::from(prefix))
+        build_vendored("integrations/btcpp/build-btcpp.sh", &btcpp_archive())
     });
     match found {
         Ok(p) => Some(p.clone()),
@@ -290,6 +267,69 @@ pub fn btcpp() -> Option<PathBuf> {
                 &format!(
                     "{why}; `bash integrations/btcpp/build-btcpp.sh` builds it from \
                      ../shared/vendor, or set BTC_BTCPP to an install prefix"
+                ),
+            );
+            None
+        }
+    }
+}
+
+/// Runs a build script of `integrations/` on a vendored source archive
+/// and returns the last line it prints (what it built), or why not.
+fn build_vendored(script: &str, archive: &Path) -> Result<PathBuf, String> {
+    if !archive.is_file() {
+        return Err(format!("{} is not there", archive.display()));
+    }
+    if Command::new("cmake").arg("--version").output().is_err() {
+        return Err("cmake is not installed (`apt-get install cmake`)".into());
+    }
+    let script = repo().join(script);
+    let out = Command::new("bash")
+        .arg(&script)
+        .arg(archive)
+        .output()
+        .map_err(|e| format!("{} does not run: {e}", script.display()))?;
+    if !out.status.success() {
+        let err = String::from_utf8_lossy(&out.stderr);
+        let tail: Vec<&str> = err.lines().rev().take(15).collect();
+        return Err(format!(
+            "building it failed:\n{}",
+            tail.into_iter().rev().collect::<Vec<_>>().join("\n")
+        ));
+    }
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    Ok(PathBuf::from(stdout.lines().last().unwrap_or("").trim()))
+}
+
+/// VAL's `Validate` binary (KCL-Planning/VAL, the reference PDDL plan
+/// validator), or `None` after [`skip`]. `BTC_VAL` names an existing
+/// binary; otherwise `integrations/val/build-val.sh` builds it from
+/// `../shared/vendor/VAL-3c7a1f3.tar.gz` (or `BTC_VAL_ARCHIVE`) into
+/// `~/.cache/btc/val-<sha256>` (once: later calls find it there).
+pub fn val() -> Option<PathBuf> {
+    static FOUND: OnceLock<Result<PathBuf, String>> = OnceLock::new();
+    let found = FOUND.get_or_init(|| {
+        if let Some(p) = std::env::var_os("BTC_VAL") {
+            let p = PathBuf::from(p);
+            return if p.is_file() {
+                Ok(p)
+            } else {
+                Err(format!("BTC_VAL={} is no file", p.display()))
+            };
+        }
+        let archive = std::env::var_os("BTC_VAL_ARCHIVE")
+            .map(PathBuf::from)
+            .unwrap_or_else(|| repo().join("../shared/vendor/VAL-3c7a1f3.tar.gz"));
+        build_vendored("integrations/val/build-val.sh", &archive)
+    });
+    match found {
+        Ok(p) => Some(p.clone()),
+        Err(why) => {
+            skip(
+                "VAL's Validate",
+                &format!(
+                    "{why}; `bash integrations/val/build-val.sh` builds it from \
+                     ../shared/vendor, or set BTC_VAL to the binary"
                 ),
             );
             None

@@ -8,8 +8,13 @@ use crate::state::{Cond, State, World};
 use serde::Serialize;
 
 mod ground;
+mod interference;
+pub mod schedule;
 mod step;
+mod timed;
 mod tracked;
+
+pub use timed::DEFAULT_EPSILON;
 
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Validation {
@@ -45,8 +50,47 @@ pub fn validate(
     plan: &Plan,
     steps: &[GroundStep],
 ) -> Validation {
-    let mut state = world.initial_state();
+    validate_with(replay, world, domain, problem, plan, steps, DEFAULT_EPSILON)
+}
+
+/// [`validate`] with a separation tolerance for timed plans: a plan whose
+/// steps all have times is replayed with PDDL 2.1's temporal semantics
+/// (see [`timed`]); any other plan one step after another.
+pub fn validate_with(
+    replay: Replay,
+    world: &World,
+    domain: &Domain,
+    problem: &Problem,
+    plan: &Plan,
+    steps: &[GroundStep],
+    epsilon: f64,
+) -> Validation {
+    let timed = !plan.steps.is_empty() && plan.steps.iter().all(|s| s.time.is_some());
+    if timed {
+        return timed::validate_timed(world, domain, problem, plan, steps, epsilon);
+    }
     let mut diags = Vec::new();
+    if let Some(a) = domain.actions.iter().find(|a| a.durative) {
+        if let Some(step) = plan.steps.iter().find(|s| s.time.is_none()) {
+            diags.push(
+                Diagnostic::warning(
+                    codes::UNTIMED_PLAN,
+                    step.span,
+                    format!(
+                        "the domain has durative actions (`{}`), but this plan has no times: \
+                         its steps are replayed one after another, each ending before the next \
+                         starts, and no durations are checked",
+                        a.name.name
+                    ),
+                )
+                .with_hint(
+                    "timed plans read `0.000: (action args) [duration]` (PDDL 2.1, as \
+                     temporal planners write them); `btc plan` writes one for a durative domain",
+                ),
+            );
+        }
+    }
+    let mut state = world.initial_state();
     let mut stepper = step::Stepper::new(world, domain, replay == Replay::Cached);
     for (n, g) in steps.iter().enumerate() {
         let applied = stepper.apply(&mut state, plan, g);
@@ -62,7 +106,20 @@ pub fn validate(
         }
     }
     stepper.settle(&mut state);
-    let cost = cost(world, &state, steps.len());
+    finish(world, problem, plan, state, steps.len(), diags)
+}
+
+/// The validation of a plan all of whose `steps` applied, ending in
+/// `state`: the goal checked, the stated cost compared.
+fn finish(
+    world: &World,
+    problem: &Problem,
+    plan: &Plan,
+    state: State,
+    steps: usize,
+    mut diags: Vec<Diagnostic>,
+) -> Validation {
+    let cost = cost(world, &state, steps);
     let mut valid = true;
     if let (Some(goal), Some(cond)) = (&problem.goal, world.goal()) {
         let missing = missing_goals(world, &state, goal, cond);
@@ -84,8 +141,7 @@ pub fn validate(
                     ),
                 )
                 .with_hint(format!(
-                    "after all {} steps these goal conditions still fail",
-                    steps.len()
+                    "after all {steps} steps these goal conditions still fail"
                 )),
             );
         }
@@ -104,7 +160,7 @@ pub fn validate(
     }
     Validation {
         valid,
-        steps_applied: steps.len(),
+        steps_applied: steps,
         cost,
         diagnostics: diags,
     }

@@ -118,14 +118,14 @@ const AT_END: &str = "its `at end` condition";
 
 /// The domain's actions, each converted and compiled once, when a step
 /// first uses it.
-struct Actions<'a> {
+pub(super) struct Actions<'a> {
     world: &'a World,
     domain: &'a Domain,
     compiled: Vec<Option<Rc<CompiledAction>>>,
 }
 
 impl<'a> Actions<'a> {
-    fn new(world: &'a World, domain: &'a Domain) -> Actions<'a> {
+    pub fn new(world: &'a World, domain: &'a Domain) -> Actions<'a> {
         Actions {
             world,
             domain,
@@ -133,7 +133,7 @@ impl<'a> Actions<'a> {
         }
     }
 
-    fn get(&mut self, i: usize) -> Result<Step<'a>, Diagnostic> {
+    pub fn get(&mut self, i: usize) -> Result<Step<'a>, Diagnostic> {
         let ast = &self.domain.actions[i];
         if self.compiled[i].is_none() {
             let c = self
@@ -156,9 +156,9 @@ impl<'a> Actions<'a> {
 }
 
 /// An action as the AST has it (for spans) and compiled (to evaluate).
-struct Step<'a> {
-    ast: &'a Action,
-    compiled: Rc<CompiledAction>,
+pub(super) struct Step<'a> {
+    pub ast: &'a Action,
+    pub compiled: Rc<CompiledAction>,
 }
 
 struct StepCtx<'w> {

@@ -9,8 +9,12 @@ use btc_pddl::pipeline::{domain_unit, plan_unit, problem_unit, validate_units};
 use btc_pddl::pipeline::{DomainUnit, ProblemUnit};
 use btc_pddl::render::to_short;
 use btc_pddl::source::Sources;
+use btc_pddl::state::World;
+use btc_pddl::validate::schedule::{schedule, Schedule};
+use btc_pddl::validate::DEFAULT_EPSILON;
 use btc_planner::{Options, Outcome, Report};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// Where the corpus is; a test that reads it first asks
 /// `btc_testkit::corpus()`, which skips it when the corpus is missing.
@@ -72,6 +76,34 @@ impl Loaded {
         )
     }
 
+    /// A plan as `btc plan` writes it: a `sas_plan`, or for a domain with
+    /// durative actions a timed plan scheduled from it.
+    pub fn plan_text(&self, plan: &btc_planner::Plan) -> String {
+        let domain = self.du.domain.as_ref().unwrap();
+        match self.schedule(plan) {
+            Some(s) => btc_planner::to_timed_plan(domain, &self.pu.index, plan, &s),
+            None => btc_planner::to_sas_plan(domain, &self.pu.index, plan),
+        }
+    }
+
+    /// The plan's schedule, for a domain with durative actions.
+    pub fn schedule(&self, plan: &btc_planner::Plan) -> Option<Schedule> {
+        let (domain, problem) = (
+            self.du.domain.as_ref().unwrap(),
+            self.pu.problem.as_ref().unwrap(),
+        );
+        if !domain.actions.iter().any(|a| a.durative) {
+            return None;
+        }
+        let world = World::of_checked(domain, &self.du.index, problem, &self.pu.index).unwrap();
+        let steps: Vec<(usize, Arc<[u32]>)> = plan
+            .steps
+            .iter()
+            .map(|s| (s.action, s.args.as_slice().into()))
+            .collect();
+        Some(schedule(&world, domain, problem, &steps, DEFAULT_EPSILON).unwrap())
+    }
+
     /// Plans, writes the `sas_plan` text, validates it; returns the text
     /// and the validated cost.
     pub fn solve_and_validate(&mut self, opts: &Options) -> (String, f64, Report) {
@@ -87,7 +119,7 @@ impl Loaded {
         let Outcome::Plan(plan) = &report.outcome else {
             panic!("no plan: {:?}", report.outcome);
         };
-        let text = btc_planner::to_sas_plan(self.du.domain.as_ref().unwrap(), &self.pu.index, plan);
+        let text = self.plan_text(plan);
         let f = self.sources.add("planned.plan", text.clone());
         let lu = plan_unit(&self.sources, f, &self.du, &self.pu);
         let v = validate_units(&self.du, &self.pu, &lu).expect("plan types");
