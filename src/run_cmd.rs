@@ -415,10 +415,19 @@ fn execute(
     // The trace goes out tick by tick: bounded memory, and a killed run
     // leaves every line so far (SIGINT/SIGTERM flush it).
     let trace = a.trace.as_deref().map(files::stream).transpose()?;
+    // The trace file is written (and the trace forgotten) tick by tick; a
+    // `.btlog`, written at the end, needs every transition: it keeps them.
+    let mut for_btlog = Vec::new();
+    let mut stream = |e: &mut Engine<'_>, t: &btc_files::Stream| {
+        if a.btlog.is_some() {
+            for_btlog.extend(e.trace.iter().cloned());
+        }
+        let mut w: &btc_files::Stream = t;
+        let _ = e.drain_trace(&mut w).and_then(|()| t.flush());
+    };
     let status = engine.run(a.max_ticks, |e| {
         if let Some(t) = &trace {
-            let mut w: &btc_files::Stream = t;
-            let _ = e.drain_trace(&mut w).and_then(|()| t.flush());
+            stream(e, t);
         }
         if let Some(pb) = &bar {
             pb.set_position(e.steps_done() as u64);
@@ -433,10 +442,10 @@ fn execute(
     }
     let commands = engine.take_controller().map(Controller::shutdown);
     if let (Some(t), Some(path)) = (trace, &a.trace) {
-        let mut w: &btc_files::Stream = &t;
-        let _ = engine.drain_trace(&mut w);
+        stream(&mut engine, &t);
         t.finish()
             .map_err(|e| anyhow::anyhow!("cannot write `{}`: {e}", path.display()))?;
+        engine.trace = for_btlog;
     }
     if let Some(path) = &a.btlog {
         match btc_runtime::btlog::write(doc, &engine, status, ms_per_tick, started) {

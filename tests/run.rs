@@ -235,6 +235,22 @@ fn btlog_writes_a_groot2_replay_of_the_run() {
         .filter(|l| l.contains("\"from\""))
         .count();
     assert_eq!(b.len() - (31 + n), 9 * (changes + 1));
+    // With the trace file too, the replay keeps every transition (the
+    // trace is streamed tick by tick; the replay used to find it drained).
+    let both = dir.path().join("both.btlog");
+    let traced = dir.path().join("both.jsonl");
+    let out = run_ariac(&[
+        "--btlog",
+        both.to_str().unwrap(),
+        "--trace",
+        traced.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0));
+    assert_eq!(std::fs::read(&both).unwrap().len(), b.len());
+    assert_eq!(
+        std::fs::read_to_string(&traced).unwrap(),
+        std::fs::read_to_string(&trace).unwrap()
+    );
     // Groot2 opens only `.btlog` files.
     let bad = run_ariac(&["--btlog", "run.log"]);
     assert_eq!(bad.status.code(), Some(2));
