@@ -5,13 +5,9 @@ use crate::{files, report, Format};
 use btc_pddl::diagnostic::has_errors;
 use btc_pddl::pipeline::{domain_unit, problem_unit};
 use btc_pddl::source::Sources;
-use btc_pddl::state::World;
-use btc_pddl::validate::schedule::{schedule, Schedule};
-use btc_pddl::validate::DEFAULT_EPSILON;
 use btc_planner::{Heuristic, Options, Outcome};
 use std::path::Path;
 use std::process::ExitCode;
-use std::sync::Arc;
 
 pub struct PlanArgs<'a> {
     pub domain: &'a Path,
@@ -70,7 +66,8 @@ pub fn run(args: &PlanArgs) -> anyhow::Result<ExitCode> {
     let mut plan_json = None;
     match &report.outcome {
         Outcome::Plan(plan) => {
-            let schedule = timed_schedule(domain, &du.index, problem, &pu.index, plan)?;
+            let schedule = btc_planner::schedule_plan(domain, &du.index, problem, &pu.index, plan)
+                .map_err(anyhow::Error::msg)?;
             let text = match &schedule {
                 Some(s) => btc_planner::to_timed_plan(domain, &pu.index, plan, s),
                 None => btc_planner::to_sas_plan(domain, &pu.index, plan),
@@ -146,30 +143,6 @@ pub fn run(args: &PlanArgs) -> anyhow::Result<ExitCode> {
         );
     }
     finish(&diags, &sources, args.format, Some((stats, plan_json)))
-}
-
-/// For a domain with durative actions, the plan scheduled into a timed
-/// plan (steps as early as the steps they interfere with allow); `None`
-/// for a classical domain.
-fn timed_schedule(
-    domain: &btc_pddl::ast::Domain,
-    dix: &btc_pddl::DomainIndex,
-    problem: &btc_pddl::ast::Problem,
-    pix: &btc_pddl::ProblemIndex,
-    plan: &btc_planner::Plan,
-) -> anyhow::Result<Option<Schedule>> {
-    if !domain.actions.iter().any(|a| a.durative) {
-        return Ok(None);
-    }
-    let world = World::of_checked(domain, dix, problem, pix).map_err(anyhow::Error::msg)?;
-    let steps: Vec<(usize, Arc<[u32]>)> = plan
-        .steps
-        .iter()
-        .map(|s| (s.action, s.args.as_slice().into()))
-        .collect();
-    let s =
-        schedule(&world, domain, problem, &steps, DEFAULT_EPSILON).map_err(anyhow::Error::msg)?;
-    Ok(Some(s))
 }
 
 fn finish(

@@ -224,6 +224,35 @@ fn cost_line(plan: &Plan) -> String {
     format!("; cost = {total} ({kind})\n")
 }
 
+/// For a domain with durative actions, `plan` scheduled into a timed plan
+/// (see [`btc_pddl::validate::schedule`], with the default tolerance);
+/// `None` for a classical domain.
+pub fn schedule_plan(
+    domain: &Domain,
+    dix: &DomainIndex,
+    problem: &Problem,
+    pix: &ProblemIndex,
+    plan: &Plan,
+) -> Result<Option<btc_pddl::validate::schedule::Schedule>, String> {
+    if !domain.actions.iter().any(|a| a.durative) {
+        return Ok(None);
+    }
+    let world = btc_pddl::state::World::of_checked(domain, dix, problem, pix)?;
+    let steps: Vec<(usize, std::sync::Arc<[u32]>)> = plan
+        .steps
+        .iter()
+        .map(|s| (s.action, s.args.as_slice().into()))
+        .collect();
+    btc_pddl::validate::schedule::schedule(
+        &world,
+        domain,
+        problem,
+        &steps,
+        btc_pddl::validate::DEFAULT_EPSILON,
+    )
+    .map(Some)
+}
+
 /// A durative domain's plan as a temporal planner writes it: one
 /// `start: (action args) [duration]` per line, in time order, then the
 /// makespan and the cost. `schedule` gives each step's start and duration

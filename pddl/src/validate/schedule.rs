@@ -65,6 +65,12 @@ pub fn schedule(
             })?,
             _ => 0.0,
         };
+        if !(duration.is_finite() && duration >= 0.0) {
+            return Err(format!(
+                "`{}` would take {duration}, which no step can take",
+                a.ast.name.name
+            ));
+        }
         let conds: Vec<_> = [&c.pre_start, &c.pre_over_all, &c.pre_end]
             .into_iter()
             .flatten()

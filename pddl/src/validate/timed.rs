@@ -248,6 +248,15 @@ impl<'a> TimedReplay<'a> {
                             .with_hint(format!("write `[{a:.3}]` after the step")))
                     }
                     (Some(s), _) => Ok(Some(s)),
+                    (None, Some(a)) if !(a.is_finite() && a >= 0.0) => Err(self.error(
+                        codes::DURATION_NOT_ALLOWED,
+                        event,
+                        action,
+                        format_args!(
+                            "states no duration, and its `:duration` makes it {a} here, \
+                             which no step can take"
+                        ),
+                    )),
                     (None, a) => Ok(a),
                 }
             }

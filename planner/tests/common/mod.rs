@@ -9,12 +9,9 @@ use btc_pddl::pipeline::{domain_unit, plan_unit, problem_unit, validate_units};
 use btc_pddl::pipeline::{DomainUnit, ProblemUnit};
 use btc_pddl::render::to_short;
 use btc_pddl::source::Sources;
-use btc_pddl::state::World;
-use btc_pddl::validate::schedule::{schedule, Schedule};
-use btc_pddl::validate::DEFAULT_EPSILON;
+use btc_pddl::validate::schedule::Schedule;
 use btc_planner::{Options, Outcome, Report};
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 
 /// Where the corpus is; a test that reads it first asks
 /// `btc_testkit::corpus()`, which skips it when the corpus is missing.
@@ -88,20 +85,14 @@ impl Loaded {
 
     /// The plan's schedule, for a domain with durative actions.
     pub fn schedule(&self, plan: &btc_planner::Plan) -> Option<Schedule> {
-        let (domain, problem) = (
+        btc_planner::schedule_plan(
             self.du.domain.as_ref().unwrap(),
+            &self.du.index,
             self.pu.problem.as_ref().unwrap(),
-        );
-        if !domain.actions.iter().any(|a| a.durative) {
-            return None;
-        }
-        let world = World::of_checked(domain, &self.du.index, problem, &self.pu.index).unwrap();
-        let steps: Vec<(usize, Arc<[u32]>)> = plan
-            .steps
-            .iter()
-            .map(|s| (s.action, s.args.as_slice().into()))
-            .collect();
-        Some(schedule(&world, domain, problem, &steps, DEFAULT_EPSILON).unwrap())
+            &self.pu.index,
+            plan,
+        )
+        .unwrap()
     }
 
     /// Plans, writes the `sas_plan` text, validates it; returns the text
