@@ -37,6 +37,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
             "btc-runtime",
         ],
     ),
+    ("btc-python", &["btc-api"]),
     ("btc-lsp", &["btc-files", "btc-ir", "btc-lang", "btc-pddl"]),
     ("btc-testkit", &[]),
     ("btc-files", &[]),

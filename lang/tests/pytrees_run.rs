@@ -643,6 +643,7 @@ fn hostile_names_stay_strings() {
                         "import argparse",
                         "import json",
                         "import time",
+                        "import weakref",
                     ]
                     .contains(&line.trim()),
                     "unexpected import line: {line}"
