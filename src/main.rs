@@ -88,6 +88,10 @@ enum Command {
         /// Write here (atomically) instead of to stdout.
         #[arg(short = 'o', long = "output")]
         output: Option<PathBuf>,
+        /// Write nothing: exit 1 when the `-o` file (or the py_trees
+        /// runtime beside it) would change.
+        #[arg(long, requires = "output")]
+        check: bool,
         /// BT.CPP: one flat tree instead of a SubTree per rule.
         #[arg(long)]
         inline: bool,
@@ -98,6 +102,11 @@ enum Command {
         /// (`btc_runtime.py`, written beside an `-o` output).
         #[arg(long, value_enum, default_value_t = RuntimeArg::Inline)]
         runtime: RuntimeArg,
+        /// py_trees: name the domain and problem files in the module's
+        /// header (relative to the output's folder, as the JSON IR records
+        /// them).
+        #[arg(long)]
+        source_paths: bool,
         /// Compile a plan that does not replay on its problem (a step whose
         /// precondition fails, a goal not reached), with warnings.
         #[arg(long)]
@@ -300,9 +309,11 @@ fn main() -> ExitCode {
             domain,
             emit,
             output,
+            check,
             inline,
             node_module,
             runtime,
+            source_paths,
             allow_invalid_plan,
             format,
         } => rules_cmd::compile(&rules_cmd::CompileArgs {
@@ -312,10 +323,12 @@ fn main() -> ExitCode {
             domain,
             emit: emit.into(),
             output,
+            check,
             options: btc_emit::Options {
                 inline,
                 node_module,
                 runtime: runtime.into(),
+                source_paths,
             },
             allow_invalid_plan,
             format,
