@@ -3,6 +3,7 @@
 
 mod executor_cmd;
 mod files;
+mod init_cmd;
 mod paths;
 mod pddl_cmd;
 mod plan_cmd;
@@ -136,6 +137,20 @@ enum Command {
         #[arg(long, value_enum, default_value_t)]
         format: Format,
     },
+    /// Start a rules file from a PDDL domain: a rule per action, each
+    /// calling a leaf declared with the action's parameters as typed ports.
+    Init {
+        domain: PathBuf,
+        /// A problem for the rules file to name (its `problem` line).
+        problem: Option<PathBuf>,
+        /// The rules file to write (default: `rules.btrules` beside the
+        /// domain); an existing file is never overwritten.
+        #[arg(short = 'o', long = "output")]
+        output: Option<PathBuf>,
+    },
+    /// Add a rule stub to a rules file for each domain action no rule
+    /// covers (the file's own text is kept byte for byte).
+    Stubs { rules: PathBuf },
     /// Format `.btrules` files in place.
     Fmt {
         #[arg(required = true)]
@@ -346,6 +361,12 @@ fn main() -> ExitCode {
             check,
             format,
         }),
+        Command::Init {
+            domain,
+            problem,
+            output,
+        } => init_cmd::init(&domain, problem.as_deref(), output.as_deref()),
+        Command::Stubs { rules } => init_cmd::stubs(&rules),
         Command::Fmt { files, check } => rules_cmd::fmt(&files, check),
         Command::Lsp => btc_lsp::run_stdio()
             .map(|()| ExitCode::SUCCESS)

@@ -699,6 +699,23 @@ pub fn file_coverage(db: &dyn Db, file: SourceFile) -> Vec<Finding> {
         .enumerate()
         .filter_map(|(k, i)| rule_facts(db, *i).as_ref().map(|f| (k, f)))
         .collect();
+    // A file with no rule, nor an import with one, is a file being started
+    // (unless an import could not be read: it may have rules).
+    let no_rules = facts.is_empty()
+        && !d.actions.is_empty()
+        && import_closure(db, file).1.is_empty()
+        && import_closure(db, file).0.iter().all(|f| {
+            !parsed_rules(db, *f)
+                .items
+                .iter()
+                .any(|n| matches!(&*n.item, Item::Rule(_)))
+        });
+    if no_rules {
+        return vec![Finding::NoRules {
+            actions: d.actions.len(),
+            file_name: file.path(db).file_name().unwrap_or("FILE").to_owned(),
+        }];
+    }
     file_checks::coverage(&facts, d.actions.len())
 }
 
