@@ -10,6 +10,7 @@ mod plan_cmd;
 mod report;
 mod rules_cmd;
 mod run_cmd;
+mod test_cmd;
 mod trial_cmd;
 mod validate_cmd;
 
@@ -151,6 +152,23 @@ enum Command {
     /// Add a rule stub to a rules file for each domain action no rule
     /// covers (the file's own text is kept byte for byte).
     Stubs { rules: PathBuf },
+    /// Snapshot tests of a rules file's trees and runs: each plan beside it
+    /// (or in its `plans/` folder) is compiled and run, and compared with
+    /// its snapshots in `snapshots/` (insta's `.snap` format); exit 1 on a
+    /// change, with a diff and the new version as `.snap.new`.
+    Test {
+        rules: PathBuf,
+        /// The tree formats to snapshot (repeat it; default: btcpp and
+        /// mermaid). The run is always snapshotted.
+        #[arg(long, value_enum)]
+        emit: Vec<TestFormat>,
+        /// Take the new versions: write them over the stored snapshots.
+        #[arg(long, conflicts_with = "check")]
+        accept: bool,
+        /// Write nothing (for CI): exit 1 on any new or changed snapshot.
+        #[arg(long)]
+        check: bool,
+    },
     /// Format `.btrules` files in place.
     Fmt {
         #[arg(required = true)]
@@ -253,6 +271,31 @@ impl From<EmitFormat> for rules_cmd::Output {
             EmitFormat::Mermaid => Tree(F::Mermaid),
             EmitFormat::Commands => Tree(F::Commands),
             EmitFormat::Kb => Kb,
+        }
+    }
+}
+
+/// The tree formats `btc test` snapshots.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum TestFormat {
+    Btcpp,
+    Pytrees,
+    Json,
+    Dot,
+    Mermaid,
+    Commands,
+}
+
+impl From<TestFormat> for btc_emit::Format {
+    fn from(f: TestFormat) -> Self {
+        use btc_emit::Format as F;
+        match f {
+            TestFormat::Btcpp => F::Btcpp,
+            TestFormat::Pytrees => F::Pytrees,
+            TestFormat::Json => F::Json,
+            TestFormat::Dot => F::Dot,
+            TestFormat::Mermaid => F::Mermaid,
+            TestFormat::Commands => F::Commands,
         }
     }
 }
@@ -367,6 +410,21 @@ fn main() -> ExitCode {
             output,
         } => init_cmd::init(&domain, problem.as_deref(), output.as_deref()),
         Command::Stubs { rules } => init_cmd::stubs(&rules),
+        Command::Test {
+            rules,
+            emit,
+            accept,
+            check,
+        } => test_cmd::run(&test_cmd::TestArgs {
+            rules,
+            targets: if emit.is_empty() {
+                vec![btc_emit::Format::Btcpp, btc_emit::Format::Mermaid]
+            } else {
+                emit.into_iter().map(Into::into).collect()
+            },
+            accept,
+            check,
+        }),
         Command::Fmt { files, check } => rules_cmd::fmt(&files, check),
         Command::Lsp => btc_lsp::run_stdio()
             .map(|()| ExitCode::SUCCESS)

@@ -167,21 +167,16 @@ pub fn load_job(
     })
 }
 
-pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
-    let mut job = load_job(
-        &a.rules,
-        PlanSource::File(FilePath::new(&a.plan)),
-        a.problem.as_deref(),
-        a.domain.as_deref(),
-        a.allow_invalid_plan,
-    )?;
+/// The job's tree, or `None` with what refuses it added to the job's
+/// diagnostics; with `pytrees`, what a py_trees module cannot express is
+/// refused too, never approximated.
+pub fn tree_of(job: &mut Job, pytrees: bool) -> Option<Arc<btc_ir::TreeIr>> {
     let mut result = if has_errors(&job.diagnostics) {
         None
     } else {
         db::compile(&job.db, job.job()).as_ref().ok().cloned()
     };
-    // What the target cannot express is refused, never approximated.
-    if let (Some(ir), Output::Tree(emit::Format::Pytrees)) = (&result, a.emit) {
+    if let (Some(ir), true) = (&result, pytrees) {
         let refused = targets::refusals(&job.db, job.job(), ir, targets::Target::Pytrees);
         if !refused.is_empty() {
             job.diagnostics.extend(refused);
@@ -197,6 +192,29 @@ pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
             }
         }
     }
+    result
+}
+
+/// Records the files a tree was compiled from relative to `base`, the
+/// folder of its output, so that no output depends on where btc ran or
+/// how it was given its paths.
+pub fn record_paths_from(ir: &mut btc_ir::TreeIr, base: &Path) {
+    for p in [&mut ir.domain, &mut ir.problem, &mut ir.plan, &mut ir.rules] {
+        if !p.is_empty() {
+            *p = crate::paths::text(&crate::paths::relative_to(Path::new(p.as_str()), base));
+        }
+    }
+}
+
+pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
+    let mut job = load_job(
+        &a.rules,
+        PlanSource::File(FilePath::new(&a.plan)),
+        a.problem.as_deref(),
+        a.domain.as_deref(),
+        a.allow_invalid_plan,
+    )?;
+    let result = tree_of(&mut job, a.emit == Output::Tree(emit::Format::Pytrees));
     let sources = job.db.sources_for(&job.diagnostics);
     let json = report::diagnostics(&job.diagnostics, &sources, a.format);
     let Some(mut ir) = result else {
@@ -225,23 +243,9 @@ pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
             // and replay (half of what a long plan's compile holds) are
             // freed before the output is made, not kept beside it.
             drop(job);
-            // The files the tree was compiled from are recorded relative
-            // to the output's folder (standard output: the rules file's),
-            // so no output depends on where btc ran or how it was given
-            // its paths (the IR is ours alone now: no copy).
-            let ir_mut = Arc::make_mut(&mut ir);
-            let base = output_folder(a);
-            for p in [
-                &mut ir_mut.domain,
-                &mut ir_mut.problem,
-                &mut ir_mut.plan,
-                &mut ir_mut.rules,
-            ] {
-                if !p.is_empty() {
-                    *p =
-                        crate::paths::text(&crate::paths::relative_to(Path::new(p.as_str()), base));
-                }
-            }
+            // Relative to the output's folder (standard output: the rules
+            // file's); the IR is ours alone now: no copy.
+            record_paths_from(Arc::make_mut(&mut ir), output_folder(a));
             deliver(a, &mut |w| emit::emit_to(&ir, f, &a.options, w), &what)?
         }
         Output::Kb => {
