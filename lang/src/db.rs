@@ -48,11 +48,13 @@ pub trait Db: salsa::Database {
 }
 
 /// The stdlib modules built into the binary.
+// Read through `lang/stdlib`, a link to the repository's `stdlib/`, so
+// that the packaged crate carries the modules (`cargo package` follows it).
 pub const STDLIB: &[(&str, &str)] = &[
-    ("btcpp", include_str!("../../stdlib/btcpp.btrules")),
-    ("kb", include_str!("../../stdlib/kb.btrules")),
-    ("ariac", include_str!("../../stdlib/ariac.btrules")),
-    ("crcl", include_str!("../../stdlib/crcl.btrules")),
+    ("btcpp", include_str!("../stdlib/btcpp.btrules")),
+    ("kb", include_str!("../stdlib/kb.btrules")),
+    ("ariac", include_str!("../stdlib/ariac.btrules")),
+    ("crcl", include_str!("../stdlib/crcl.btrules")),
 ];
 
 #[salsa::db]
