@@ -161,7 +161,7 @@ enum Command {
         /// The tree formats to snapshot (repeat it; default: btcpp and
         /// mermaid). The run is always snapshotted.
         #[arg(long, value_enum)]
-        emit: Vec<TestFormat>,
+        emit: Vec<EmitFormat>,
         /// Take the new versions: write them over the stored snapshots.
         #[arg(long, conflicts_with = "check")]
         accept: bool,
@@ -275,31 +275,6 @@ impl From<EmitFormat> for rules_cmd::Output {
     }
 }
 
-/// The tree formats `btc test` snapshots.
-#[derive(Clone, Copy, Debug, ValueEnum)]
-enum TestFormat {
-    Btcpp,
-    Pytrees,
-    Json,
-    Dot,
-    Mermaid,
-    Commands,
-}
-
-impl From<TestFormat> for btc_emit::Format {
-    fn from(f: TestFormat) -> Self {
-        use btc_emit::Format as F;
-        match f {
-            TestFormat::Btcpp => F::Btcpp,
-            TestFormat::Pytrees => F::Pytrees,
-            TestFormat::Json => F::Json,
-            TestFormat::Dot => F::Dot,
-            TestFormat::Mermaid => F::Mermaid,
-            TestFormat::Commands => F::Commands,
-        }
-    }
-}
-
 /// How a py_trees module gets btc's runtime.
 #[derive(Clone, Copy, Debug, ValueEnum)]
 enum RuntimeArg {
@@ -348,6 +323,21 @@ fn plan_options(
         timeout,
         improve,
     })
+}
+
+/// `btc test`'s formats: trees only (default: BT.CPP XML and Mermaid).
+fn test_formats(emit: Vec<EmitFormat>) -> anyhow::Result<Vec<btc_emit::Format>> {
+    if emit.is_empty() {
+        return Ok(vec![btc_emit::Format::Btcpp, btc_emit::Format::Mermaid]);
+    }
+    emit.into_iter()
+        .map(|f| match rules_cmd::Output::from(f) {
+            rules_cmd::Output::Tree(f) => Ok(f),
+            rules_cmd::Output::Kb => {
+                anyhow::bail!("`btc test` snapshots trees: `--emit kb` is not one")
+            }
+        })
+        .collect()
 }
 
 fn main() -> ExitCode {
@@ -415,15 +405,13 @@ fn main() -> ExitCode {
             emit,
             accept,
             check,
-        } => test_cmd::run(&test_cmd::TestArgs {
-            rules,
-            targets: if emit.is_empty() {
-                vec![btc_emit::Format::Btcpp, btc_emit::Format::Mermaid]
-            } else {
-                emit.into_iter().map(Into::into).collect()
-            },
-            accept,
-            check,
+        } => test_formats(emit).and_then(|targets| {
+            test_cmd::run(&test_cmd::TestArgs {
+                rules,
+                targets,
+                accept,
+                check,
+            })
         }),
         Command::Fmt { files, check } => rules_cmd::fmt(&files, check),
         Command::Lsp => btc_lsp::run_stdio()

@@ -230,7 +230,7 @@ pub fn run(a: &TestArgs) -> anyhow::Result<ExitCode> {
     for case in &cases {
         let mut job = rules_cmd::load_job(
             &a.rules,
-            PlanSource::File(FilePath::new(&dir.join(case))),
+            PlanSource::File(FilePath::new(dir.join(case))),
             None,
             None,
             false,
@@ -270,7 +270,7 @@ pub fn run(a: &TestArgs) -> anyhow::Result<ExitCode> {
                         (false, false) => "changed (new version in .snap.new)",
                     };
                     println!("{case} {}: {verb}", target.name());
-                    if !(a.accept && !a.check) {
+                    if !a.accept {
                         print!(
                             "{}",
                             diff(

@@ -78,7 +78,7 @@ fn btc_test_on_every_example() {
         exits(&first, 0, &format!("{name}: first run"));
         let written = snapshots(&dir, ".snap");
         assert!(
-            !written.is_empty() && written.len() % 3 == 0,
+            !written.is_empty() && written.len().is_multiple_of(3),
             "{name}: {written:?}"
         );
         for kind in ["btcpp", "mermaid", "run"] {

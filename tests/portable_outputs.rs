@@ -36,7 +36,7 @@ fn targets() -> Vec<String> {
     targets
 }
 
-/// The examples with a plan: (folder, rules file name, plan file name).
+/// The examples with a plan: (folder, plan file name).
 fn examples() -> Vec<(PathBuf, String)> {
     let mut out = Vec::new();
     for e in std::fs::read_dir(repo().join("examples")).unwrap() {
@@ -44,13 +44,14 @@ fn examples() -> Vec<(PathBuf, String)> {
         if !dir.join("rules.btrules").is_file() {
             continue;
         }
-        let mut plans: Vec<String> = std::fs::read_dir(&dir)
+        let name = dir.file_name().unwrap().to_string_lossy().into_owned();
+        let plan = support::plan_of(&name);
+        let plan = Path::new(&plan)
+            .file_name()
             .unwrap()
-            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-            .filter(|n| n.starts_with("plan."))
-            .collect();
-        plans.sort();
-        out.push((dir, plans.remove(0)));
+            .to_string_lossy()
+            .into_owned();
+        out.push((dir, plan));
     }
     out.sort();
     assert!(out.len() >= 4, "examples: {out:?}");

@@ -108,10 +108,7 @@ pub const SUPPORT_NODES: &[&str] = &["KbHolds", "KbApply", "KbStep", "WaitForSte
 /// `emit/btcpp`, a link to `integrations/btcpp`, so that the packaged
 /// crate carries the files (`cargo package` follows the link).
 const SUPPORT: &[(&str, &str)] = &[
-    (
-        "CMakeLists.txt",
-        include_str!("../btcpp/CMakeLists.txt"),
-    ),
+    ("CMakeLists.txt", include_str!("../btcpp/CMakeLists.txt")),
     (
         "cmake/btc_btcppConfig.cmake.in",
         include_str!("../btcpp/cmake/btc_btcppConfig.cmake.in"),
@@ -124,30 +121,12 @@ const SUPPORT: &[(&str, &str)] = &[
         "include/btc/nodes.hpp",
         include_str!("../btcpp/include/btc/nodes.hpp"),
     ),
-    (
-        "src/sexp.hpp",
-        include_str!("../btcpp/src/sexp.hpp"),
-    ),
-    (
-        "src/sexp.cpp",
-        include_str!("../btcpp/src/sexp.cpp"),
-    ),
-    (
-        "src/world.hpp",
-        include_str!("../btcpp/src/world.hpp"),
-    ),
-    (
-        "src/world.cpp",
-        include_str!("../btcpp/src/world.cpp"),
-    ),
-    (
-        "src/kb.cpp",
-        include_str!("../btcpp/src/kb.cpp"),
-    ),
-    (
-        "src/nodes.cpp",
-        include_str!("../btcpp/src/nodes.cpp"),
-    ),
+    ("src/sexp.hpp", include_str!("../btcpp/src/sexp.hpp")),
+    ("src/sexp.cpp", include_str!("../btcpp/src/sexp.cpp")),
+    ("src/world.hpp", include_str!("../btcpp/src/world.hpp")),
+    ("src/world.cpp", include_str!("../btcpp/src/world.cpp")),
+    ("src/kb.cpp", include_str!("../btcpp/src/kb.cpp")),
+    ("src/nodes.cpp", include_str!("../btcpp/src/nodes.cpp")),
     (
         "include/btc/executor.hpp",
         include_str!("../btcpp/include/btc/executor.hpp"),

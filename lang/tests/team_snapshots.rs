@@ -44,7 +44,7 @@ fn tree(rules: &Path, plan: &Path, format: Format) -> String {
     let ir = compile(&db, job.job)
         .as_ref()
         .unwrap_or_else(|errors| panic!("{errors:#?}"));
-    emit(&ir, format, &Options::default())
+    emit(ir, format, &Options::default())
 }
 
 #[test]
