@@ -197,6 +197,16 @@ pub fn write_produced(
         .map_err(|e| anyhow::anyhow!("cannot write `{}`: {e}", path.display()))
 }
 
+/// Whether writing what `produce` writes would change the file at `path`
+/// (`--check`): nothing is written.
+pub fn would_change(
+    path: &Path,
+    produce: &mut btc_files::write::Produce<'_>,
+) -> anyhow::Result<btc_files::Comparison> {
+    btc_files::would_change(path, produce)
+        .map_err(|e| anyhow::anyhow!("cannot read `{}`: {e}", path.display()))
+}
+
 /// Opens an output that is written as it is produced (`--trace`).
 pub fn stream(path: &Path) -> anyhow::Result<btc_files::Stream> {
     make_parent(path)?;

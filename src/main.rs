@@ -4,12 +4,14 @@
 mod domain_lookup;
 mod executor_cmd;
 mod files;
+mod init_cmd;
 mod paths;
 mod pddl_cmd;
 mod plan_cmd;
 mod report;
 mod rules_cmd;
 mod run_cmd;
+mod test_cmd;
 mod trial_cmd;
 mod validate_cmd;
 
@@ -89,6 +91,10 @@ enum Command {
         /// Write here (atomically) instead of to stdout.
         #[arg(short = 'o', long = "output")]
         output: Option<PathBuf>,
+        /// Write nothing: exit 1 when the `-o` file (or the py_trees
+        /// runtime beside it) would change.
+        #[arg(long, requires = "output")]
+        check: bool,
         /// BT.CPP: one flat tree instead of a SubTree per rule.
         #[arg(long)]
         inline: bool,
@@ -99,6 +105,11 @@ enum Command {
         /// (`btc_runtime.py`, written beside an `-o` output).
         #[arg(long, value_enum, default_value_t = RuntimeArg::Inline)]
         runtime: RuntimeArg,
+        /// py_trees: name the domain and problem files in the module's
+        /// header (relative to the output's folder, as the JSON IR records
+        /// them).
+        #[arg(long)]
+        source_paths: bool,
         /// Compile a plan that does not replay on its problem (a step whose
         /// precondition fails, a goal not reached), with warnings.
         #[arg(long)]
@@ -127,6 +138,37 @@ enum Command {
         /// How to print diagnostics.
         #[arg(long, value_enum, default_value_t)]
         format: Format,
+    },
+    /// Start a rules file from a PDDL domain: a rule per action, each
+    /// calling a leaf declared with the action's parameters as typed ports.
+    Init {
+        domain: PathBuf,
+        /// A problem for the rules file to name (its `problem` line).
+        problem: Option<PathBuf>,
+        /// The rules file to write (default: `rules.btrules` beside the
+        /// domain); an existing file is never overwritten.
+        #[arg(short = 'o', long = "output")]
+        output: Option<PathBuf>,
+    },
+    /// Add a rule stub to a rules file for each domain action no rule
+    /// covers (the file's own text is kept byte for byte).
+    Stubs { rules: PathBuf },
+    /// Snapshot tests of a rules file's trees and runs: each plan beside it
+    /// (or in its `plans/` folder) is compiled and run, and compared with
+    /// its snapshots in `snapshots/` (insta's `.snap` format); exit 1 on a
+    /// change, with a diff and the new version as `.snap.new`.
+    Test {
+        rules: PathBuf,
+        /// The tree formats to snapshot (repeat it; default: btcpp and
+        /// mermaid). The run is always snapshotted.
+        #[arg(long, value_enum)]
+        emit: Vec<EmitFormat>,
+        /// Take the new versions: write them over the stored snapshots.
+        #[arg(long, conflicts_with = "check")]
+        accept: bool,
+        /// Write nothing (for CI): exit 1 on any new or changed snapshot.
+        #[arg(long)]
+        check: bool,
     },
     /// Format `.btrules` files in place.
     Fmt {
@@ -289,6 +331,21 @@ fn plan_options(
     })
 }
 
+/// `btc test`'s formats: trees only (default: BT.CPP XML and Mermaid).
+fn test_formats(emit: Vec<EmitFormat>) -> anyhow::Result<Vec<btc_emit::Format>> {
+    if emit.is_empty() {
+        return Ok(vec![btc_emit::Format::Btcpp, btc_emit::Format::Mermaid]);
+    }
+    emit.into_iter()
+        .map(|f| match rules_cmd::Output::from(f) {
+            rules_cmd::Output::Tree(f) => Ok(f),
+            rules_cmd::Output::Kb => {
+                anyhow::bail!("`btc test` snapshots trees: `--emit kb` is not one")
+            }
+        })
+        .collect()
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
@@ -306,9 +363,11 @@ fn main() -> ExitCode {
             domain,
             emit,
             output,
+            check,
             inline,
             node_module,
             runtime,
+            source_paths,
             allow_invalid_plan,
             format,
         } => rules_cmd::compile(&rules_cmd::CompileArgs {
@@ -318,10 +377,12 @@ fn main() -> ExitCode {
             domain,
             emit: emit.into(),
             output,
+            check,
             options: btc_emit::Options {
                 inline,
                 node_module,
                 runtime: runtime.into(),
+                source_paths,
             },
             allow_invalid_plan,
             format,
@@ -338,6 +399,25 @@ fn main() -> ExitCode {
             name: name.as_deref(),
             check,
             format,
+        }),
+        Command::Init {
+            domain,
+            problem,
+            output,
+        } => init_cmd::init(&domain, problem.as_deref(), output.as_deref()),
+        Command::Stubs { rules } => init_cmd::stubs(&rules),
+        Command::Test {
+            rules,
+            emit,
+            accept,
+            check,
+        } => test_formats(emit).and_then(|targets| {
+            test_cmd::run(&test_cmd::TestArgs {
+                rules,
+                targets,
+                accept,
+                check,
+            })
         }),
         Command::Fmt { files, check } => rules_cmd::fmt(&files, check),
         Command::Lsp => btc_lsp::run_stdio()

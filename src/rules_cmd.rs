@@ -91,6 +91,8 @@ pub struct CompileArgs {
     pub domain: Option<PathBuf>,
     pub emit: Output,
     pub output: Option<PathBuf>,
+    /// Write nothing; say whether the `-o` file would change.
+    pub check: bool,
     pub options: emit::Options,
     pub allow_invalid_plan: bool,
     pub format: Format,
@@ -172,21 +174,16 @@ pub fn load_job(
     })
 }
 
-pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
-    let mut job = load_job(
-        &a.rules,
-        PlanSource::File(FilePath::new(&a.plan)),
-        a.problem.as_deref(),
-        a.domain.as_deref(),
-        a.allow_invalid_plan,
-    )?;
+/// The job's tree, or `None` with what refuses it added to the job's
+/// diagnostics; with `pytrees`, what a py_trees module cannot express is
+/// refused too, never approximated.
+pub fn tree_of(job: &mut Job, pytrees: bool) -> Option<Arc<btc_ir::TreeIr>> {
     let mut result = if has_errors(&job.diagnostics) {
         None
     } else {
         db::compile(&job.db, job.job()).as_ref().ok().cloned()
     };
-    // What the target cannot express is refused, never approximated.
-    if let (Some(ir), Output::Tree(emit::Format::Pytrees)) = (&result, a.emit) {
+    if let (Some(ir), true) = (&result, pytrees) {
         let refused = targets::refusals(&job.db, job.job(), ir, targets::Target::Pytrees);
         if !refused.is_empty() {
             job.diagnostics.extend(refused);
@@ -202,6 +199,29 @@ pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
             }
         }
     }
+    result
+}
+
+/// Records the files a tree was compiled from relative to `base`, the
+/// folder of its output, so that no output depends on where btc ran or
+/// how it was given its paths.
+pub fn record_paths_from(ir: &mut btc_ir::TreeIr, base: &Path) {
+    for p in [&mut ir.domain, &mut ir.problem, &mut ir.plan, &mut ir.rules] {
+        if !p.is_empty() {
+            *p = crate::paths::text(&crate::paths::relative_to(Path::new(p.as_str()), base));
+        }
+    }
+}
+
+pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
+    let mut job = load_job(
+        &a.rules,
+        PlanSource::File(FilePath::new(&a.plan)),
+        a.problem.as_deref(),
+        a.domain.as_deref(),
+        a.allow_invalid_plan,
+    )?;
+    let result = tree_of(&mut job, a.emit == Output::Tree(emit::Format::Pytrees));
     let sources = job.db.sources_for(&job.diagnostics);
     let json = report::diagnostics(&job.diagnostics, &sources, a.format);
     let Some(mut ir) = result else {
@@ -224,22 +244,16 @@ pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
         ir.steps.len() - steps,
         job.problem_shown()
     );
-    match a.emit {
+    let current = match a.emit {
         Output::Tree(f) => {
             // A tree's emitter reads the IR alone: the plan's text, parse
             // and replay (half of what a long plan's compile holds) are
             // freed before the output is made, not kept beside it.
             drop(job);
-            // A JSON IR records the files it was compiled from relative
-            // to its own folder (the IR is ours alone now: no copy).
-            if let (Some(out), emit::Format::Json) = (&a.output, f) {
-                let ir = Arc::make_mut(&mut ir);
-                let dir = out.parent().unwrap_or(Path::new(""));
-                for p in [&mut ir.domain, &mut ir.problem, &mut ir.plan, &mut ir.rules] {
-                    *p = crate::paths::text(&crate::paths::relative_to(Path::new(p.as_str()), dir));
-                }
-            }
-            deliver(a, &mut |w| emit::emit_to(&ir, f, &a.options, w), &what)?;
+            // Relative to the output's folder (standard output: the rules
+            // file's); the IR is ours alone now: no copy.
+            record_paths_from(Arc::make_mut(&mut ir), output_folder(a));
+            deliver(a, &mut |w| emit::emit_to(&ir, f, &a.options, w), &what)?
         }
         Output::Kb => {
             let text = match db::JobWorld::of(&job.db, job.job()) {
@@ -248,49 +262,84 @@ pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
                     "`--emit kb` needs the PDDL problem: pass `--problem PROBLEM` or name it in the rules file"
                 ),
             };
-            deliver(a, &mut |w| w.write_all(text.as_bytes()), &what)?;
+            deliver(a, &mut |w| w.write_all(text.as_bytes()), &what)?
         }
-    }
+    };
     // The process ends here: freeing the IR piece by piece would take time
     // the OS saves by reclaiming it at once.
     std::mem::forget(ir);
-    Ok(ExitCode::SUCCESS)
+    Ok(if current {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
+    })
+}
+
+/// The folder an output's recorded paths are relative to: the `-o` file's,
+/// or for standard output the rules file's (where a project keeps its
+/// outputs, and the same wherever btc runs).
+fn output_folder(a: &CompileArgs) -> &Path {
+    let file = a.output.as_deref().unwrap_or(&a.rules);
+    file.parent().unwrap_or(Path::new(""))
 }
 
 /// Writes a compiled output where `a` sends it: the file `-o` names
 /// (atomically, with the imported py_trees runtime beside it) or standard
-/// output; `what` is the summary said on standard error.
+/// output; `what` is the summary said on standard error. With `--check`,
+/// writes nothing and returns whether the files are up to date.
 fn deliver(
     a: &CompileArgs,
     produce: &mut btc_files::write::Produce<'_>,
     what: &str,
-) -> anyhow::Result<()> {
-    match &a.output {
-        Some(out) => {
-            files::write_produced(out, produce)?;
-            eprintln!("wrote {}: {what}", out.display());
-            // An imported runtime goes beside the module, where its import
-            // finds it; it is btc's file and always rewritten.
-            if a.emit == Output::Tree(emit::Format::Pytrees)
-                && a.options.runtime == emit::pytrees::Runtime::Import
-            {
-                let dir = out.parent().unwrap_or(Path::new(""));
-                let rt = dir.join(format!("{}.py", emit::pytrees::RUNTIME_MODULE));
-                files::write_atomically(&rt, emit::pytrees::RUNTIME)?;
-                eprintln!("wrote {}", rt.display());
-            }
+) -> anyhow::Result<bool> {
+    let Some(out) = &a.output else {
+        let mut stdout = std::io::stdout().lock();
+        match produce(&mut stdout).and_then(|()| stdout.flush()) {
+            Ok(()) => eprintln!("compiled {}: {what}", a.plan.display()),
+            // A reader that stopped early (`| head`) wanted no more.
+            Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {}
+            Err(e) => anyhow::bail!("cannot write to standard output: {e}"),
         }
-        None => {
-            let mut stdout = std::io::stdout().lock();
-            match produce(&mut stdout).and_then(|()| stdout.flush()) {
-                Ok(()) => eprintln!("compiled {}: {what}", a.plan.display()),
-                // A reader that stopped early (`| head`) wanted no more.
-                Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {}
-                Err(e) => anyhow::bail!("cannot write to standard output: {e}"),
-            }
+        return Ok(true);
+    };
+    // An imported runtime goes beside the module, where its import finds
+    // it; it is btc's file and always rewritten.
+    let runtime = (a.emit == Output::Tree(emit::Format::Pytrees)
+        && a.options.runtime == emit::pytrees::Runtime::Import)
+        .then(|| {
+            let dir = out.parent().unwrap_or(Path::new(""));
+            dir.join(format!("{}.py", emit::pytrees::RUNTIME_MODULE))
+        });
+    if a.check {
+        let mut current = true;
+        let mut runtime_text =
+            |w: &mut dyn std::io::Write| w.write_all(emit::pytrees::RUNTIME.as_bytes());
+        let outputs: [(Option<&Path>, &mut btc_files::write::Produce<'_>); 2] = [
+            (Some(out), produce),
+            (runtime.as_deref(), &mut runtime_text),
+        ];
+        for (path, produce) in outputs {
+            let Some(path) = path else { continue };
+            let status = match files::would_change(path, produce)? {
+                btc_files::Comparison::Same => continue,
+                btc_files::Comparison::Differs => "out of date",
+                btc_files::Comparison::Missing => "missing",
+            };
+            println!("{}: {status}", path.display());
+            current = false;
         }
+        if current {
+            eprintln!("{}: up to date ({what})", out.display());
+        }
+        return Ok(current);
     }
-    Ok(())
+    files::write_produced(out, produce)?;
+    eprintln!("wrote {}: {what}", out.display());
+    if let Some(rt) = runtime {
+        files::write_atomically(&rt, emit::pytrees::RUNTIME)?;
+        eprintln!("wrote {}", rt.display());
+    }
+    Ok(true)
 }
 
 /// `btc fmt [--check] FILES`: formats in place (atomically), or with

@@ -137,6 +137,75 @@ fn output_files_are_written_whole_or_not_at_all() {
     );
 }
 
+/// `compile --check -o FILE` is CI's "is the committed tree current": exit
+/// 1 when FILE is missing or would change, 0 when it would not, and never a
+/// byte written (nor the py_trees runtime an imported module needs).
+#[test]
+fn compile_check_says_whether_the_output_would_change_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("tree.py");
+    let runtime = dir.path().join("btc_runtime.py");
+    let compile = |extra: &[&str]| {
+        let mut args = vec![
+            "compile",
+            "examples/two_robots/rules.btrules",
+            "--plan",
+            "examples/two_robots/plan.plan",
+            "--emit",
+            "pytrees",
+            "--runtime",
+            "import",
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        btc(&args)
+    };
+    let listing = || {
+        let mut names: Vec<String> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        names.sort();
+        names
+    };
+    // Nothing there yet: both files are missing, and stay so.
+    let missing = compile(&["--check"]);
+    support::exits(&missing, 1, "--check with no file");
+    let said = String::from_utf8_lossy(&missing.stdout);
+    assert!(said.contains("tree.py: missing"), "{said}");
+    assert!(said.contains("btc_runtime.py: missing"), "{said}");
+    assert!(listing().is_empty(), "{:?}", listing());
+    // Written, then current.
+    support::exits(&compile(&[]), 0, "compile");
+    support::exits(&compile(&["--check"]), 0, "--check after compile");
+    // One byte changed in either file: out of date, and left as it is.
+    for file in [&out, &runtime] {
+        let good = std::fs::read(file).unwrap();
+        let mut changed = good.clone();
+        changed.push(b'\n');
+        std::fs::write(file, &changed).unwrap();
+        let stale = compile(&["--check"]);
+        support::exits(&stale, 1, "--check on a changed file");
+        let said = String::from_utf8_lossy(&stale.stdout);
+        assert!(said.contains("out of date"), "{said}");
+        assert_eq!(std::fs::read(file).unwrap(), changed);
+        std::fs::write(file, &good).unwrap();
+    }
+    assert_eq!(listing(), ["btc_runtime.py", "tree.py"]);
+    // `--check` needs a file to compare with.
+    let no_file = btc(&[
+        "compile",
+        "examples/two_robots/rules.btrules",
+        "--plan",
+        "examples/two_robots/plan.plan",
+        "--emit",
+        "btcpp",
+        "--check",
+    ]);
+    support::exits(&no_file, 2, "--check without -o");
+}
+
 /// A long plan's tree is streamed: to a file and to standard output it is
 /// the same bytes, and a reader that stops early (`| head`) ends the
 /// compile quietly, not with a panic.

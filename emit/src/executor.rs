@@ -104,55 +104,36 @@ pub const BTCPP_BUILTINS: &[&str] = &[
 /// The nodes btc's support library registers (`btc::registerKbNodes`).
 pub const SUPPORT_NODES: &[&str] = &["KbHolds", "KbApply", "KbStep", "WaitForStep"];
 
-/// btc's support library, written into `btc_support/`.
+/// btc's support library, written into `btc_support/`. Read through
+/// `emit/btcpp`, a link to `integrations/btcpp`, so that the packaged
+/// crate carries the files (`cargo package` follows the link).
 const SUPPORT: &[(&str, &str)] = &[
-    (
-        "CMakeLists.txt",
-        include_str!("../../integrations/btcpp/CMakeLists.txt"),
-    ),
+    ("CMakeLists.txt", include_str!("../btcpp/CMakeLists.txt")),
     (
         "cmake/btc_btcppConfig.cmake.in",
-        include_str!("../../integrations/btcpp/cmake/btc_btcppConfig.cmake.in"),
+        include_str!("../btcpp/cmake/btc_btcppConfig.cmake.in"),
     ),
     (
         "include/btc/kb.hpp",
-        include_str!("../../integrations/btcpp/include/btc/kb.hpp"),
+        include_str!("../btcpp/include/btc/kb.hpp"),
     ),
     (
         "include/btc/nodes.hpp",
-        include_str!("../../integrations/btcpp/include/btc/nodes.hpp"),
+        include_str!("../btcpp/include/btc/nodes.hpp"),
     ),
-    (
-        "src/sexp.hpp",
-        include_str!("../../integrations/btcpp/src/sexp.hpp"),
-    ),
-    (
-        "src/sexp.cpp",
-        include_str!("../../integrations/btcpp/src/sexp.cpp"),
-    ),
-    (
-        "src/world.hpp",
-        include_str!("../../integrations/btcpp/src/world.hpp"),
-    ),
-    (
-        "src/world.cpp",
-        include_str!("../../integrations/btcpp/src/world.cpp"),
-    ),
-    (
-        "src/kb.cpp",
-        include_str!("../../integrations/btcpp/src/kb.cpp"),
-    ),
-    (
-        "src/nodes.cpp",
-        include_str!("../../integrations/btcpp/src/nodes.cpp"),
-    ),
+    ("src/sexp.hpp", include_str!("../btcpp/src/sexp.hpp")),
+    ("src/sexp.cpp", include_str!("../btcpp/src/sexp.cpp")),
+    ("src/world.hpp", include_str!("../btcpp/src/world.hpp")),
+    ("src/world.cpp", include_str!("../btcpp/src/world.cpp")),
+    ("src/kb.cpp", include_str!("../btcpp/src/kb.cpp")),
+    ("src/nodes.cpp", include_str!("../btcpp/src/nodes.cpp")),
     (
         "include/btc/executor.hpp",
-        include_str!("../../integrations/btcpp/include/btc/executor.hpp"),
+        include_str!("../btcpp/include/btc/executor.hpp"),
     ),
     (
         "src/executor.cpp",
-        include_str!("../../integrations/btcpp/src/executor.cpp"),
+        include_str!("../btcpp/src/executor.cpp"),
     ),
 ];
 

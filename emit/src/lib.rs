@@ -98,6 +98,10 @@ pub struct Options {
     pub node_module: Option<String>,
     /// py_trees: paste the runtime in, or import `btc_runtime`.
     pub runtime: pytrees::Runtime,
+    /// py_trees: name the domain and problem files (as the IR records
+    /// them) in the module's header. Off by default, so a module's text
+    /// does not depend on where its inputs were.
+    pub source_paths: bool,
 }
 
 impl Options {
@@ -105,6 +109,7 @@ impl Options {
         pytrees::PyOptions {
             runtime: self.runtime,
             node_module: self.node_module.as_deref(),
+            source_paths: self.source_paths,
         }
     }
 }

@@ -48,11 +48,13 @@ pub trait Db: salsa::Database {
 }
 
 /// The stdlib modules built into the binary.
+// Read through `lang/stdlib`, a link to the repository's `stdlib/`, so
+// that the packaged crate carries the modules (`cargo package` follows it).
 pub const STDLIB: &[(&str, &str)] = &[
-    ("btcpp", include_str!("../../stdlib/btcpp.btrules")),
-    ("kb", include_str!("../../stdlib/kb.btrules")),
-    ("ariac", include_str!("../../stdlib/ariac.btrules")),
-    ("crcl", include_str!("../../stdlib/crcl.btrules")),
+    ("btcpp", include_str!("../stdlib/btcpp.btrules")),
+    ("kb", include_str!("../stdlib/kb.btrules")),
+    ("ariac", include_str!("../stdlib/ariac.btrules")),
+    ("crcl", include_str!("../stdlib/crcl.btrules")),
 ];
 
 #[salsa::db]
@@ -699,6 +701,23 @@ pub fn file_coverage(db: &dyn Db, file: SourceFile) -> Vec<Finding> {
         .enumerate()
         .filter_map(|(k, i)| rule_facts(db, *i).as_ref().map(|f| (k, f)))
         .collect();
+    // A file with no rule, nor an import with one, is a file being started
+    // (unless an import could not be read: it may have rules).
+    let no_rules = facts.is_empty()
+        && !d.actions.is_empty()
+        && import_closure(db, file).1.is_empty()
+        && import_closure(db, file).0.iter().all(|f| {
+            !parsed_rules(db, *f)
+                .items
+                .iter()
+                .any(|n| matches!(&*n.item, Item::Rule(_)))
+        });
+    if no_rules {
+        return vec![Finding::NoRules {
+            actions: d.actions.len(),
+            file_name: file.path(db).file_name().unwrap_or("FILE").to_owned(),
+        }];
+    }
     file_checks::coverage(&facts, d.actions.len())
 }
 

@@ -13,4 +13,5 @@ pub mod path;
 pub mod project;
 pub mod resolutions;
 pub mod rules;
+pub mod stubs;
 pub mod targets;

@@ -1187,7 +1187,7 @@ pub fn node_model(id: &str, n: &NodeDecl) -> NodeModel {
 
 /// The `std::kb` declarations btc itself emits, available without import.
 fn kb_decl(id: &str) -> Option<NodeDecl> {
-    let parsed = crate::rules::parse_rules(include_str!("../../stdlib/kb.btrules"), 0);
+    let parsed = crate::rules::parse_rules(include_str!("../stdlib/kb.btrules"), 0);
     parsed
         .items
         .into_iter()

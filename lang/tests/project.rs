@@ -150,9 +150,13 @@ fn undecodable_bytes_are_a_diagnostic_of_their_file() {
     let mut db = Database::new();
     let rules =
         project::load_rules(&mut db, &loader, &FilePath::new("cell/latin1.btrules")).unwrap();
+    // (and, the file having no rules yet, R025 says how to start)
     assert_eq!(
         codes(&db, rules),
-        [("cell/latin1.btrules".to_owned(), "F002")]
+        [
+            ("cell/latin1.btrules".to_owned(), "F002"),
+            ("cell/latin1.btrules".to_owned(), "R025")
+        ]
     );
 }
 

@@ -278,6 +278,7 @@ fn the_p3_example_runs_with_its_own_behaviours() {
         &PyOptions {
             runtime: pytrees::Runtime::Import,
             node_module: Some("p3_nodes"),
+            source_paths: false,
         },
     );
     assert!(text.contains("\nfrom btc_runtime import (\n"));

@@ -1,16 +1,13 @@
 //! Formatting and code actions: quick fixes from diagnostics, and rule
-//! stubs for the domain actions no rule covers.
+//! stubs for the domain actions no rule covers (`btc_lang::stubs`, which
+//! `btc stubs` writes too).
 
 use crate::analysis::Analysis;
 use crate::convert::LineIndex;
 use crate::workspace::Workspace;
-use btc_lang::db::{checked_domain, import_closure, parsed_rules, rules_diagnostics};
+use btc_lang::db::{checked_domain, parsed_rules, rules_diagnostics};
 use btc_lang::path::FilePath;
-use btc_lang::rules::ast::Item;
 use btc_lang::rules::fmt::format_parsed;
-use btc_lang::rules::matching::match_name;
-use btc_lang::rules::name::camel_case;
-use btc_pddl::ast::{Action, TypeSpec};
 use btc_pddl::diagnostic::Diagnostic;
 use std::collections::HashMap;
 use tower_lsp::lsp_types::{
@@ -48,8 +45,8 @@ pub fn code_actions(
     let mut diags = rules_diagnostics(&a.ws.db, a.file).clone();
     btc_lang::project::suggest_paths(&a.ws.db, a.ws.loader(), a.file, &mut diags);
     let mut out = quick_fixes(&diags, file_id, ix, uri, range, to_lsp);
-    if let Some(text) = rule_stubs(a) {
-        let uncovered = text.matches("\nrule (").count();
+    if let Some(stubs) = btc_lang::stubs::missing(&a.ws.db, a.file) {
+        let uncovered = stubs.actions.len();
         out.push(CodeAction {
             title: format!(
                 "Add rule stubs for {uncovered} uncovered domain action{}",
@@ -60,7 +57,7 @@ pub fn code_actions(
                 uri,
                 vec![TextEdit::new(
                     Range::new(ix.position(a.text.len()), ix.position(a.text.len())),
-                    text,
+                    stubs.text,
                 )],
             )),
             ..CodeAction::default()
@@ -118,80 +115,6 @@ fn quick_fixes(
         }
     }
     out
-}
-
-fn port_name(var: &str) -> String {
-    var.replace('-', "_")
-}
-
-fn port_type(t: &TypeSpec) -> String {
-    match t {
-        TypeSpec::Named { name } => name.name.to_string(),
-        TypeSpec::Object | TypeSpec::Either { .. } => "object".into(),
-    }
-}
-
-/// Text to append to the file: for each domain action no rule in scope
-/// covers, a leaf declaration (unless one of that name exists) and a rule
-/// that calls it, with parameters named as in the domain.
-pub fn rule_stubs(a: &Analysis) -> Option<String> {
-    let (_, domain, _) = a.domain?;
-    let mut patterns = Vec::new();
-    for f in import_closure(&a.ws.db, a.file).0.iter() {
-        for n in &parsed_rules(&a.ws.db, *f).items {
-            if let Item::Rule(r) = &*n.item {
-                patterns.push(&r.pattern.name);
-            }
-        }
-    }
-    let uncovered: Vec<&Action> = domain
-        .actions
-        .iter()
-        .filter(|act| {
-            !patterns
-                .iter()
-                .any(|p| match_name(p, &act.name.name).is_some())
-        })
-        .collect();
-    if uncovered.is_empty() {
-        return None;
-    }
-    let mut text = String::new();
-    if !a.text.ends_with('\n') && !a.text.is_empty() {
-        text.push('\n');
-    }
-    for act in uncovered {
-        let node = camel_case(&act.name.name);
-        text.push('\n');
-        if !a.decls.nodes.contains_key(&node) && !a.decls.trees.contains_key(&node) {
-            let ports: Vec<String> = act
-                .params
-                .iter()
-                .map(|p| format!("{}: {}", port_name(&p.name.name), port_type(&p.ty)))
-                .collect();
-            text.push_str(&format!("action {node}({})\n", ports.join(", ")));
-        }
-        let vars: Vec<String> = act
-            .params
-            .iter()
-            .map(|p| format!("?{}", p.name.name))
-            .collect();
-        let args: Vec<String> = act
-            .params
-            .iter()
-            .map(|p| format!("{}: ?{}", port_name(&p.name.name), p.name.name))
-            .collect();
-        let head = if vars.is_empty() {
-            act.name.name.to_string()
-        } else {
-            format!("{} {}", act.name.name, vars.join(" "))
-        };
-        text.push_str(&format!(
-            "rule ({head}) {{\n    {node}({})\n}}\n",
-            args.join(", ")
-        ));
-    }
-    Some(text)
 }
 
 /// Where an edit lands, for tests: the text with the edits applied.

@@ -326,6 +326,7 @@ pub mod codes {
         R_PLAN_BLOCK = "R022", "a `plan` block that is missing, repeated or has no `steps`";
         R_BAD_ARGUMENT = "R023", "a control or decorator argument that makes no sense";
         R_LOOKUP_OBJECT = "R024", "a table lookup by a variable, with no key for an object of the problem the variable can stand for";
+        R_NO_RULES = "R025", "a rules file with a domain and no rules yet";
         R_EFFECT_UNBOUND = "R033", "a rule effect that reads an optional parameter a step leaves out";
         R_BACKCHAIN = "R034", "a plan `steps backchained` cannot regress its goal through";
         // .btrules: rules that no step can match, and skips that lose effects

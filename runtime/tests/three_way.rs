@@ -79,7 +79,7 @@ fn pytrees_outcome(ex: &Example, name: &str) -> Outcome {
         &ex.ir,
         &PyOptions {
             runtime: Runtime::Import,
-            node_module: None,
+            ..PyOptions::default()
         },
     );
     std::fs::write(dir.join("module.py"), text).unwrap();

@@ -6,22 +6,24 @@ use std::path::Path;
 /// Where the bundled cell's files say they are (in diagnostics).
 pub const CELL_PATH: &str = "examples/ariac_cell/cell.toml";
 
+// Read through `agent/ariac_cell`, a link to `examples/ariac_cell`, so that
+// the packaged crate carries the files (`cargo package` follows it).
 const FILES: [(&str, &str); 4] = [
     (
         "cell.toml",
-        include_str!("../../../examples/ariac_cell/cell.toml"),
+        include_str!("../../ariac_cell/cell.toml"),
     ),
     (
         "domain.pddl",
-        include_str!("../../../examples/ariac_cell/domain.pddl"),
+        include_str!("../../ariac_cell/domain.pddl"),
     ),
     (
         "floor.btrules",
-        include_str!("../../../examples/ariac_cell/floor.btrules"),
+        include_str!("../../ariac_cell/floor.btrules"),
     ),
     (
         "ceiling.btrules",
-        include_str!("../../../examples/ariac_cell/ceiling.btrules"),
+        include_str!("../../ariac_cell/ceiling.btrules"),
     ),
 ];
 

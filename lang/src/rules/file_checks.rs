@@ -157,12 +157,31 @@ pub fn rule_facts(r: &Rule, decls: &Decls, ctx: DomainCtx) -> RuleFacts {
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Finding {
     NoDomain,
-    SecondDomain { item: usize },
-    SecondPlan { item: usize },
-    Duplicate { item: usize, first: usize },
-    Uncovered { action: usize },
-    Shadowed { later: usize, earlier: usize },
-    Unused { item: usize },
+    SecondDomain {
+        item: usize,
+    },
+    SecondPlan {
+        item: usize,
+    },
+    Duplicate {
+        item: usize,
+        first: usize,
+    },
+    Uncovered {
+        action: usize,
+    },
+    /// No rule at all, here or in an import: R025 once, not R012 per action.
+    NoRules {
+        actions: usize,
+        file_name: String,
+    },
+    Shadowed {
+        later: usize,
+        earlier: usize,
+    },
+    Unused {
+        item: usize,
+    },
 }
 
 /// One `domain`, one `plan`, and each name declared once.
@@ -350,6 +369,18 @@ pub fn render(
                 a.name.name,
                 params.join(" ")
             ))
+        }
+        Finding::NoRules { actions, file_name } => {
+            let item = heads.iter().position(|h| h.kind == HeadKind::Domain)?;
+            Diagnostic::warning(
+                codes::R_NO_RULES,
+                abs(heads[item].span, item),
+                format!(
+                    "this rules file has no rules yet: no step of the domain's {actions} action{} can be compiled",
+                    if *actions == 1 { "" } else { "s" }
+                ),
+            )
+            .with_hint(format!("`btc stubs {file_name}` adds a rule per action, each calling a leaf named after it; then make the leaves your own"))
         }
         Finding::Shadowed { later, earlier } => Diagnostic::warning(
             codes::R_SHADOWED,
