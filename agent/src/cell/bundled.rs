@@ -9,14 +9,8 @@ pub const CELL_PATH: &str = "examples/ariac_cell/cell.toml";
 // Read through `agent/ariac_cell`, a link to `examples/ariac_cell`, so that
 // the packaged crate carries the files (`cargo package` follows it).
 const FILES: [(&str, &str); 4] = [
-    (
-        "cell.toml",
-        include_str!("../../ariac_cell/cell.toml"),
-    ),
-    (
-        "domain.pddl",
-        include_str!("../../ariac_cell/domain.pddl"),
-    ),
+    ("cell.toml", include_str!("../../ariac_cell/cell.toml")),
+    ("domain.pddl", include_str!("../../ariac_cell/domain.pddl")),
     (
         "floor.btrules",
         include_str!("../../ariac_cell/floor.btrules"),
