@@ -10,6 +10,7 @@ mod plan_cmd;
 mod report;
 mod rules_cmd;
 mod run_cmd;
+mod stdout;
 mod trial_cmd;
 mod validate_cmd;
 
@@ -375,6 +376,9 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(code) => code,
+        // The reader of the output stopped early (`| head`): it has what
+        // it wanted, and there is nothing to report.
+        Err(e) if e.is::<stdout::Closed>() => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");
             ExitCode::from(2)
