@@ -1,5 +1,6 @@
 //! `btc executor RULES -o DIR`: the C++ executor for BehaviorTree.CPP.
 
+use crate::stdout::outln;
 use crate::{files, report, rules_cmd, Format};
 use btc_emit::executor::{self, Owner, Spec};
 use btc_lang::db::{self, Database};
@@ -22,15 +23,16 @@ pub struct Args<'a> {
     pub format: Format,
 }
 
-fn print(diags: &[Diagnostic], sources: &Sources, format: Format, ok: bool) {
+fn print(diags: &[Diagnostic], sources: &Sources, format: Format, ok: bool) -> anyhow::Result<()> {
     let json = report::diagnostics(diags, sources, format);
     if format == Format::Json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&serde_json::json!({ "ok": ok, "diagnostics": json }))
                 .unwrap_or_default()
-        );
+        )?;
     }
+    Ok(())
 }
 
 /// The namespace: given, or the rules file's folder name.
@@ -90,7 +92,7 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
     diags.extend(executor::check(&with_spans));
     let mut sources = database.sources();
     if has_errors(&diags) {
-        print(&diags, &sources, a.format, false);
+        print(&diags, &sources, a.format, false)?;
         return Ok(ExitCode::from(1));
     }
     let name = namespace(a);
@@ -156,7 +158,7 @@ pub fn run(a: &Args) -> anyhow::Result<ExitCode> {
             files::write_atomically(&path, &text)?;
         }
     }
-    print(&diags, &sources, a.format, true);
+    print(&diags, &sources, a.format, true)?;
     if a.format == Format::Text {
         let verb = if a.check { "out of date" } else { "wrote" };
         if changed.is_empty() {

@@ -11,6 +11,7 @@ mod plan_cmd;
 mod report;
 mod rules_cmd;
 mod run_cmd;
+mod stdout;
 mod test_cmd;
 mod trial_cmd;
 mod validate_cmd;
@@ -455,6 +456,9 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(code) => code,
+        // The reader of the output stopped early (`| head`): it has what
+        // it wanted, and there is nothing to report.
+        Err(e) if e.is::<stdout::Closed>() => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");
             ExitCode::from(2)

@@ -1,5 +1,6 @@
 //! `btc pddl FILE...`: parse and check domains and problems.
 
+use crate::stdout::outln;
 use crate::{domain_lookup, files, report, Format};
 use btc_pddl::diagnostic::{codes, Diagnostic};
 use btc_pddl::pipeline::{domain_unit, problem_unit, DomainUnit};
@@ -129,10 +130,10 @@ pub fn run(
             "summaries": summaries,
             "diagnostics": diag_json,
         });
-        println!("{}", serde_json::to_string_pretty(&doc)?);
+        outln!("{}", serde_json::to_string_pretty(&doc)?)?;
     } else {
         for s in summaries {
-            println!("{s}");
+            outln!("{s}")?;
         }
     }
     Ok(if failed {

@@ -1,6 +1,7 @@
 //! `btc plan DOMAIN PROBLEM`: ground and search; the plan goes to stdout
 //! (or atomically to `-o`), statistics to stderr.
 
+use crate::stdout::{out, outln};
 use crate::{files, report, Format};
 use btc_pddl::diagnostic::has_errors;
 use btc_pddl::pipeline::{domain_unit, problem_unit};
@@ -86,7 +87,7 @@ pub fn run(args: &PlanArgs) -> anyhow::Result<ExitCode> {
             }
             match args.output {
                 Some(path) => files::write_atomically(path, &text)?,
-                None if args.format == Format::Text => print!("{text}"),
+                None if args.format == Format::Text => out!("{text}")?,
                 None => {}
             }
             plan_json = Some(serde_json::json!({
@@ -161,7 +162,7 @@ fn finish(
             "statistics": stats,
             "diagnostics": json,
         });
-        println!("{}", serde_json::to_string_pretty(&doc)?);
+        outln!("{}", serde_json::to_string_pretty(&doc)?)?;
     }
     Ok(if solved {
         ExitCode::SUCCESS

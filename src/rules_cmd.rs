@@ -1,6 +1,7 @@
 //! `btc check` and `btc compile`: rules files, through the incremental
 //! database and the project loader (the same one the language server uses).
 
+use crate::stdout::{self, outln};
 use crate::{files, report, Format};
 use btc_emit as emit;
 use btc_lang::db::{self, Database, SourceFile};
@@ -8,7 +9,6 @@ use btc_lang::path::FilePath;
 use btc_lang::project::{self, JobPaths, LoadedJob, PlanSource};
 use btc_lang::targets;
 use btc_pddl::diagnostic::{has_errors, Diagnostic, Severity};
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
@@ -46,7 +46,7 @@ pub fn check(path: &Path, format: Format) -> anyhow::Result<ExitCode> {
     let json = report::diagnostics(&diags, &sources, format);
     let (e, w) = report::count(&diags);
     match format {
-        Format::Json => println!(
+        Format::Json => outln!(
             "{}",
             serde_json::to_string_pretty(&serde_json::json!({
                 "ok": e == 0,
@@ -54,18 +54,18 @@ pub fn check(path: &Path, format: Format) -> anyhow::Result<ExitCode> {
                 "problem": problem.map(|f| f.path(&database).to_string()),
                 "diagnostics": json
             }))?
-        ),
+        )?,
         Format::Text => {
             let items = db::parsed_rules(&database, rules).items.len();
-            println!(
+            outln!(
                 "{}: {}; {}, {}",
                 path.display(),
                 report::plural(items, "item"),
                 report::plural(e, "error"),
                 report::plural(w, "warning")
-            );
-            println!("  domain: {}", shown(&database, domain, None));
-            println!("  problem: {}", shown(&database, problem, None));
+            )?;
+            outln!("  domain: {}", shown(&database, domain, None))?;
+            outln!("  problem: {}", shown(&database, problem, None))?;
         }
     }
     Ok(if e > 0 {
@@ -226,14 +226,14 @@ pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
     let json = report::diagnostics(&job.diagnostics, &sources, a.format);
     let Some(mut ir) = result else {
         if a.format == Format::Json {
-            println!(
+            outln!(
                 "{}",
                 serde_json::to_string_pretty(&serde_json::json!({
                     "ok": false,
                     "problem": job.problem_path(),
                     "diagnostics": json
                 }))?
-            );
+            )?;
         }
         return Ok(ExitCode::from(1));
     };
@@ -293,13 +293,8 @@ fn deliver(
     what: &str,
 ) -> anyhow::Result<bool> {
     let Some(out) = &a.output else {
-        let mut stdout = std::io::stdout().lock();
-        match produce(&mut stdout).and_then(|()| stdout.flush()) {
-            Ok(()) => eprintln!("compiled {}: {what}", a.plan.display()),
-            // A reader that stopped early (`| head`) wanted no more.
-            Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {}
-            Err(e) => anyhow::bail!("cannot write to standard output: {e}"),
-        }
+        stdout::with(produce)?;
+        eprintln!("compiled {}: {what}", a.plan.display());
         return Ok(true);
     };
     // An imported runtime goes beside the module, where its import finds
@@ -325,7 +320,7 @@ fn deliver(
                 btc_files::Comparison::Differs => "out of date",
                 btc_files::Comparison::Missing => "missing",
             };
-            println!("{}: {status}", path.display());
+            outln!("{}: {status}", path.display())?;
             current = false;
         }
         if current {
@@ -369,11 +364,11 @@ pub fn fmt(paths: &[PathBuf], check: bool) -> anyhow::Result<ExitCode> {
             Ok(formatted) if formatted == text => {}
             Ok(formatted) => {
                 if check {
-                    println!("{}: not formatted", path.display());
+                    outln!("{}: not formatted", path.display())?;
                     failed = true;
                 } else {
                     files::write_atomically(path, &formatted)?;
-                    println!("{}: formatted", path.display());
+                    outln!("{}: formatted", path.display())?;
                 }
             }
         }

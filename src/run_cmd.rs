@@ -1,6 +1,7 @@
 //! `btc run`: compiles a plan (or loads a tree file) and executes it with
 //! the runtime against the problem's simulated world, with injected faults.
 
+use crate::stdout::outln;
 use crate::{domain_lookup, files, paths, report, rules_cmd, Format};
 use btc_lang::db;
 use btc_lang::path::FilePath;
@@ -124,10 +125,10 @@ fn warnings(
 fn fail(diags: &[Diagnostic], sources: &Sources, format: Format) -> anyhow::Result<ExitCode> {
     let json = report::diagnostics(diags, sources, format);
     if format == Format::Json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&serde_json::json!({ "ok": false, "diagnostics": json }))?
-        );
+        )?;
     }
     Ok(ExitCode::from(1))
 }
@@ -469,9 +470,9 @@ fn execute(
             if let (Some(o), Some(kb)) = (v.as_object_mut(), &engine.kb) {
                 o.insert("kb".into(), serde_json::to_value(kb.snapshot())?);
             }
-            println!("{}", serde_json::to_string_pretty(&v)?);
+            outln!("{}", serde_json::to_string_pretty(&v)?)?;
         }
-        Format::Text => print_summary(&summary, problem, commands.as_ref().map(Vec::len)),
+        Format::Text => print_summary(&summary, problem, commands.as_ref().map(Vec::len))?,
     }
     Ok(if summary.success() {
         ExitCode::SUCCESS
@@ -480,9 +481,13 @@ fn execute(
     })
 }
 
-fn print_summary(s: &Summary, problem: Option<&str>, commands: Option<usize>) {
+fn print_summary(
+    s: &Summary,
+    problem: Option<&str>,
+    commands: Option<usize>,
+) -> anyhow::Result<()> {
     let yes = |b: bool| if b { "yes" } else { "no" };
-    println!(
+    outln!(
         "{} after {}; {} of {} plan steps done; goal reached: {}",
         s.status.name(),
         report::plural(s.ticks as usize, "tick"),
@@ -492,24 +497,25 @@ fn print_summary(s: &Summary, problem: Option<&str>, commands: Option<usize>) {
             Some(g) => yes(g),
             None => "no goal (no problem given)",
         }
-    );
-    println!("  problem: {}", problem.unwrap_or("none"));
+    )?;
+    outln!("  problem: {}", problem.unwrap_or("none"))?;
     if let Some(why) = &s.goal_failure {
-        println!("  goal: {why}");
+        outln!("  goal: {why}")?;
     }
     if let Some(n) = commands {
-        println!("controller: {} executed", report::plural(n, "command"));
+        outln!("controller: {} executed", report::plural(n, "command"))?;
     }
     for f in &s.faults {
         let met = match f.met_at {
             Some(t) => format!("met at tick {t}"),
             None => "not met".to_owned(),
         };
-        println!("fault {} ({}): {met}; {}", f.fault, f.kind.name(), f.ended);
+        outln!("fault {} ({}): {met}; {}", f.fault, f.kind.name(), f.ended)?;
     }
     for r in &s.records {
-        println!("{}", record_line(r));
+        outln!("{}", record_line(r))?;
     }
+    Ok(())
 }
 
 /// The name of the plan the closed loop writes (it is never written to
@@ -626,11 +632,11 @@ fn run_replan(a: &RunArgs, rules: &Path) -> anyhow::Result<ExitCode> {
                 o.insert("problem".into(), problem.into());
                 o.insert("diagnostics".into(), json.into());
             }
-            println!("{}", serde_json::to_string_pretty(&v)?);
+            outln!("{}", serde_json::to_string_pretty(&v)?)?;
         }
         Format::Text => {
             report::diagnostics(&diags, &sources, a.format);
-            print_loop(&summary, &problem);
+            print_loop(&summary, &problem)?;
             report::diagnostics(&summary.diagnostics, &sources, a.format);
         }
     }
@@ -643,23 +649,23 @@ fn run_replan(a: &RunArgs, rules: &Path) -> anyhow::Result<ExitCode> {
 
 /// The loop's text summary (timings are in `--format json` only, so the
 /// text is the same from run to run).
-fn print_loop(s: &btc_agent::LoopSummary, problem: &str) {
+fn print_loop(s: &btc_agent::LoopSummary, problem: &str) -> anyhow::Result<()> {
     for at in &s.attempts {
         let how = if at.source == "given" {
             "the given plan".to_owned()
         } else {
             format!("planned, {} expanded", at.expanded)
         };
-        println!(
+        outln!(
             "plan {} ({}, {how}) for {}:",
             at.attempt,
             report::plural(at.plan.len(), "step"),
             at.goal
-        );
+        )?;
         for (i, step) in at.plan.iter().enumerate() {
-            println!("  {}. {step}", i + 1);
+            outln!("  {}. {step}", i + 1)?;
         }
-        println!(
+        outln!(
             "  {} at tick {} (ticks {}-{}); {} of {} plan steps done",
             if at.preempted {
                 "PREEMPTED"
@@ -671,18 +677,18 @@ fn print_loop(s: &btc_agent::LoopSummary, problem: &str) {
             at.end_tick,
             at.steps_done,
             at.steps_total
-        );
+        )?;
         for r in &at.records {
-            println!("  {}", record_line(r));
+            outln!("  {}", record_line(r))?;
         }
         if at.status == btc_runtime::Status::Success && !at.preempted && at.goal != s.goal {
-            println!("  the priority order is done; planning for the whole goal");
+            outln!("  the priority order is done; planning for the whole goal")?;
         }
         if at.waited_ticks > 0 {
-            println!(
+            outln!(
                 "  waited {} for the faults in effect to end",
                 report::plural(at.waited_ticks as usize, "tick")
-            );
+            )?;
         }
         if let Some((k, rp)) = s
             .replans
@@ -694,9 +700,9 @@ fn print_loop(s: &btc_agent::LoopSummary, problem: &str) {
                 (Some(_), Some(a)) => format!(" from {a}"),
                 _ => String::new(),
             };
-            println!("replan {} at tick {}{from}: {}", k + 1, rp.tick, rp.why);
+            outln!("replan {} at tick {}{from}: {}", k + 1, rp.tick, rp.why)?;
             for adj in &rp.adjustments {
-                println!("  goal: {adj}");
+                outln!("  goal: {adj}")?;
             }
         }
     }
@@ -705,7 +711,7 @@ fn print_loop(s: &btc_agent::LoopSummary, problem: &str) {
             Some(t) => format!("met at tick {t}"),
             None => "not met".to_owned(),
         };
-        println!("fault {} ({}): {met}; {}", f.fault, f.kind.name(), f.ended);
+        outln!("fault {} ({}): {met}; {}", f.fault, f.kind.name(), f.ended)?;
     }
     for u in &s.unreachable {
         let by = if u.faults.is_empty() {
@@ -713,9 +719,9 @@ fn print_loop(s: &btc_agent::LoopSummary, problem: &str) {
         } else {
             format!(" (fault: {})", u.faults.join(", "))
         };
-        println!("unreachable: {}{by}", u.literal);
+        outln!("unreachable: {}{by}", u.literal)?;
     }
-    println!(
+    outln!(
         "goal {}: {} after {}, {}, {}",
         s.goal,
         if s.goal_reached {
@@ -726,14 +732,15 @@ fn print_loop(s: &btc_agent::LoopSummary, problem: &str) {
         report::plural(s.ticks as usize, "tick"),
         report::plural(s.attempts.len(), "plan"),
         report::plural(s.replans.len(), "replan"),
-    );
-    println!("  problem: {problem}");
+    )?;
+    outln!("  problem: {problem}")?;
     if let Some(why) = &s.goal_failure {
-        println!("  goal: {why}");
+        outln!("  goal: {why}")?;
     }
     if let Some(why) = &s.stopped {
-        println!("stopped: {why}");
+        outln!("stopped: {why}")?;
     }
+    Ok(())
 }
 
 /// One fault record as the summaries print it.

@@ -9,6 +9,7 @@
 //! the new versions, `--check` writes nothing. docs/testing.md is the
 //! user's page.
 
+use crate::stdout::{out, outln};
 use crate::{report, rules_cmd, Format};
 use btc_emit as emit;
 use btc_lang::path::FilePath;
@@ -239,7 +240,7 @@ pub fn run(a: &TestArgs) -> anyhow::Result<ExitCode> {
         let Some(mut ir) = rules_cmd::tree_of(&mut job, pytrees) else {
             let sources = job.db.sources_for(&job.diagnostics);
             report::diagnostics(&job.diagnostics, &sources, Format::Text);
-            println!("{case}: does not compile");
+            outln!("{case}: does not compile")?;
             failed += 1;
             continue;
         };
@@ -258,7 +259,7 @@ pub fn run(a: &TestArgs) -> anyhow::Result<ExitCode> {
                 Outcome::New => {
                     new += 1;
                     let verb = if a.check { "missing" } else { "new, written" };
-                    println!("{case} {}: {verb} ({})", target.name(), path.display());
+                    outln!("{case} {}: {verb} ({})", target.name(), path.display())?;
                 }
                 Outcome::Changed => {
                     changed += 1;
@@ -269,22 +270,22 @@ pub fn run(a: &TestArgs) -> anyhow::Result<ExitCode> {
                         (true, false) => "changed, accepted",
                         (false, false) => "changed (new version in .snap.new)",
                     };
-                    println!("{case} {}: {verb}", target.name());
+                    outln!("{case} {}: {verb}", target.name())?;
                     if !a.accept {
-                        print!(
+                        out!(
                             "{}",
                             diff(
                                 &format!("{old}\n"),
                                 &format!("{}\n", content.trim_end_matches('\n')),
                                 &name
                             )
-                        );
+                        )?;
                     }
                 }
             }
         }
     }
-    println!(
+    outln!(
         "btc test {}: {} cases; {} unchanged, {} new, {} changed, {} not compiled",
         a.rules.display(),
         cases.len(),
@@ -292,7 +293,7 @@ pub fn run(a: &TestArgs) -> anyhow::Result<ExitCode> {
         new,
         changed,
         failed
-    );
+    )?;
     let failing = failed > 0 || (changed > 0 && !a.accept) || (a.check && (new > 0 || changed > 0));
     Ok(if failing {
         ExitCode::from(1)

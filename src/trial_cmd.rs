@@ -1,6 +1,7 @@
 //! `btc trial`: runs ARIAC 2023 trial files on a cell (the bundled one, or
 //! `--cell`) with `btc_agent`'s task level, and prints the scoreboard.
 
+use crate::stdout::{out, outln};
 use crate::{files, report, Format};
 use btc_agent::cell::{self, bundled, Cell};
 use btc_agent::matrix;
@@ -75,10 +76,10 @@ fn load_cell(db: &mut Database, a: &TrialArgs) -> anyhow::Result<Result<Cell, Ve
 fn fail(diags: &[Diagnostic], db: &Database, format: Format) -> anyhow::Result<ExitCode> {
     let json = report::diagnostics(diags, &db.sources(), format);
     if format == Format::Json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&serde_json::json!({ "ok": false, "diagnostics": json }))?
-        );
+        )?;
     }
     Ok(ExitCode::from(1))
 }
@@ -161,13 +162,13 @@ pub fn run(a: &TrialArgs) -> anyhow::Result<ExitCode> {
                 doc["summary"] = serde_json::to_value(TrialsSummary::of(&runs))?;
                 doc["runs"] = serde_json::to_value(&runs)?;
             }
-            println!("{}", serde_json::to_string_pretty(&doc)?);
+            outln!("{}", serde_json::to_string_pretty(&doc)?)?;
         }
         Format::Text => {
             if runs.len() == 1 {
-                print_report(&runs[0], &t);
+                print_report(&runs[0], &t)?;
             } else {
-                print_summary(&runs, &TrialsSummary::of(&runs));
+                print_summary(&runs, &TrialsSummary::of(&runs))?;
             }
         }
     }
@@ -191,13 +192,18 @@ fn secs(x: Option<f64>) -> String {
     x.map_or_else(|| "-".to_owned(), |s| format!("{s:.0} s"))
 }
 
-fn print_report(r: &TrialReport, t: &Trial) {
-    println!(
+fn print_report(r: &TrialReport, t: &Trial) -> anyhow::Result<()> {
+    outln!(
         "trial {} (seed {}): {:.0} s, score {} of {}; {}",
-        r.trial, r.seed, r.seconds, r.score, r.best, r.stopped
-    );
-    println!();
-    println!(
+        r.trial,
+        r.seed,
+        r.seconds,
+        r.score,
+        r.best,
+        r.stopped
+    )?;
+    outln!()?;
+    outln!(
         "{:<12} {:<9} {:<5} {:<14} {:>9} {:>9} {:>7} {:>7} {:>7} {:>6}  faults",
         "order",
         "type",
@@ -209,9 +215,9 @@ fn print_report(r: &TrialReport, t: &Trial) {
         "score",
         "tasks",
         "reass."
-    );
+    )?;
     for o in &r.orders {
-        println!(
+        outln!(
             "{:<12} {:<9} {:<5} {:<14} {:>9} {:>9} {:>7} {:>7} {:>7} {:>6}  {}",
             o.id,
             o.ty.name(),
@@ -232,31 +238,35 @@ fn print_report(r: &TrialReport, t: &Trial) {
                     .collect::<Vec<_>>()
                     .join(", ")
             }
-        );
+        )?;
     }
-    println!();
+    outln!()?;
     // Timings (planning) are in the JSON report only: they vary from run
     // to run.
-    println!(
+    outln!(
         "{:<14} {:>7} {:>10} {:>7} {:>6}",
-        "agent", "busy", "tasks done", "failed", "plans"
-    );
+        "agent",
+        "busy",
+        "tasks done",
+        "failed",
+        "plans"
+    )?;
     for a in &r.agents {
-        println!(
+        outln!(
             "{:<14} {:>7} {:>10} {:>7} {:>6}",
             a.robot,
             format!("{:.0} s", a.busy),
             a.tasks_done,
             a.tasks_failed,
             a.plans
-        );
+        )?;
     }
     if !r.challenges.is_empty() {
-        println!();
-        println!("challenges:");
+        outln!()?;
+        outln!("challenges:")?;
         for c in &r.challenges {
             let at = c.met.map_or_else(String::new, |m| format!(" at {m:.0} s"));
-            println!("  {}{at}: {}", c.challenge, c.ended);
+            outln!("  {}{at}: {}", c.challenge, c.ended)?;
         }
     }
     let failed: Vec<_> = r
@@ -268,22 +278,23 @@ fn print_report(r: &TrialReport, t: &Trial) {
         })
         .collect();
     if !failed.is_empty() {
-        println!();
-        println!("part tasks not done:");
+        outln!()?;
+        outln!("part tasks not done:")?;
         for (task, cause) in failed {
-            println!(
+            outln!(
                 "  task {} of {} ({}): {}",
                 task.id,
                 t.orders[task.order].id,
                 task.work.describe(),
                 cause
-            );
+            )?;
         }
     }
+    Ok(())
 }
 
-fn print_summary(runs: &[TrialReport], s: &TrialsSummary) {
-    println!(
+fn print_summary(runs: &[TrialReport], s: &TrialsSummary) -> anyhow::Result<()> {
+    outln!(
         "trial {}: {} runs (seeds {}..{}); score {:.2} ± {:.2} (min {}, max {}); time {:.1} ± {:.1} s",
         s.trial,
         runs.len(),
@@ -295,21 +306,25 @@ fn print_summary(runs: &[TrialReport], s: &TrialsSummary) {
         s.score.max,
         s.seconds.mean,
         s.seconds.sd
-    );
-    println!();
-    println!(
+    )?;
+    outln!()?;
+    outln!(
         "{:<12} {:>16} {:>18} {:>10}",
-        "order", "score", "time", "submitted"
-    );
+        "order",
+        "score",
+        "time",
+        "submitted"
+    )?;
     for o in &s.orders {
-        println!(
+        outln!(
             "{:<12} {:>16} {:>18} {:>10}",
             o.id,
             format!("{:.2} ± {:.2}", o.score.mean, o.score.sd),
             format!("{:.1} ± {:.1} s", o.time.mean, o.time.sd),
             format!("{}/{}", o.submitted, runs.len())
-        );
+        )?;
     }
+    Ok(())
 }
 
 fn run_matrix(a: &TrialArgs, c: &Cell, db: Database) -> anyhow::Result<ExitCode> {
@@ -333,16 +348,16 @@ fn run_matrix(a: &TrialArgs, c: &Cell, db: Database) -> anyhow::Result<ExitCode>
     }
     files::write_atomically(&a.svg, &matrix::svg(&m))?;
     match a.format {
-        Format::Json => println!(
+        Format::Json => outln!(
             "{}",
             serde_json::to_string_pretty(
                 &serde_json::json!({ "ok": true, "matrix": m, "svg": a.svg })
             )?
-        ),
+        )?,
         Format::Text => {
-            print!("{}", matrix::table(&m));
-            println!();
-            println!("chart: {}", a.svg.display());
+            out!("{}", matrix::table(&m))?;
+            outln!()?;
+            outln!("chart: {}", a.svg.display())?;
         }
     }
     Ok(ExitCode::SUCCESS)

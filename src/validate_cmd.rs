@@ -1,5 +1,6 @@
 //! `btc validate DOMAIN PROBLEM PLAN`
 
+use crate::stdout::outln;
 use crate::{files, report, Format};
 use btc_lang::project::FileLoader;
 use btc_pddl::diagnostic::has_errors;
@@ -94,25 +95,25 @@ pub fn run(
                 "plan_format": lu.plan.format,
                 "diagnostics": json,
             });
-            println!("{}", serde_json::to_string_pretty(&doc)?);
+            outln!("{}", serde_json::to_string_pretty(&doc)?)?;
         }
         Format::Text => match &validation {
-            Some(v) if v.valid => println!(
+            Some(v) if v.valid => outln!(
                 "valid: {} reach the goal (cost {})",
                 report::plural(steps, "step"),
                 v.cost
-            ),
-            Some(v) => println!(
+            )?,
+            Some(v) => outln!(
                 "invalid: {} of {} applied",
                 report::plural(v.steps_applied, "step"),
                 steps
-            ),
+            )?,
             None => {
                 let (e, _) = report::count(&diags);
-                println!(
+                outln!(
                     "not validated: {} in the inputs",
                     report::plural(e, "error")
-                );
+                )?;
             }
         },
     }

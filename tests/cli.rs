@@ -261,6 +261,60 @@ fn a_long_plan_streams_to_a_file_and_to_a_reader_that_stops() {
     assert!(!stderr.contains("panicked"), "{stderr}");
 }
 
+/// Every command that prints its result ends quietly when its reader has
+/// gone before it writes (`btc plan ... --format json | head -c 10`): the
+/// pipe's read end is closed before btc starts, so every write fails.
+#[test]
+fn every_command_ends_quietly_when_its_reader_has_gone() {
+    let out_dir = tempfile::tempdir().unwrap();
+    let out = out_dir.path().display().to_string();
+    let (ariac, p3) = ("examples/ariac", "examples/p3_assembler");
+    let rules = format!("{ariac}/rules.btrules");
+    let plan = format!("{ariac}/plan.txt");
+    let (d, p) = (format!("{p3}/domain.pddl"), format!("{p3}/problem.pddl"));
+    let timed = format!("{p3}/plan.tplan");
+    let trial = "examples/ariac_cell/trials/mixed.yaml";
+    let commands: Vec<Vec<&str>> = vec![
+        vec!["plan", &d, &p],
+        vec!["validate", &d, &p, &timed],
+        vec!["pddl", &d, &p],
+        vec!["pddl", &d, "--json"],
+        vec!["check", &rules],
+        vec!["compile", &rules, "--plan", &plan, "--emit", "btcpp"],
+        vec!["run", &rules, "--plan", &plan],
+        vec!["run", &rules, "--replan"],
+        vec!["trial", trial],
+        vec!["executor", &rules, "-o", &out],
+    ];
+    let runs = commands
+        .iter()
+        .flat_map(|c| {
+            [
+                [&c[..], &["--format", "text"]].concat(),
+                [&c[..], &["--format", "json"]].concat(),
+            ]
+        })
+        .chain([vec!["fmt", "--check", &rules]]);
+    for args in runs {
+        let (reader, writer) = std::io::pipe().unwrap();
+        drop(reader);
+        let run = std::process::Command::new(env!("CARGO_BIN_EXE_btc"))
+            .args(&args)
+            .env("NO_COLOR", "1")
+            .stdout(writer)
+            .stderr(std::process::Stdio::piped())
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        let what = format!("btc {}", args.join(" "));
+        assert!(
+            !stderr.contains("panicked") && !stderr.contains("Broken pipe"),
+            "{what}: {stderr}"
+        );
+        assert!(run.status.success(), "{what}: {:?}\n{stderr}", run.status);
+    }
+}
+
 /// The two example files of the design page (btrules v1, kept as
 /// `tests/fixtures/design/`) parse and check as written.
 #[test]

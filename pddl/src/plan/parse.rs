@@ -248,6 +248,27 @@ impl<'a> LineReader<'a> {
         // `TIME: (...)`, `N: NAME ARGS` (FF continuation) or `Header: ...`
         if let Some(head) = first.strip_suffix(':').or_else(|| self.colon_after(first)) {
             if let Ok(time) = head.parse::<f64>() {
+                if head.starts_with('-') && time.is_finite() {
+                    let after_head = self.pos;
+                    self.skip_ws();
+                    if self.peek() == Some(b'(') {
+                        // `-0.000:` is a printing of 0; any other negative
+                        // time is before the plan starts, never a comment.
+                        if time != 0.0 {
+                            return Err(self
+                                .error(
+                                    wstart,
+                                    wstart + head.len(),
+                                    format!("a step starts at a negative time, `{head}`"),
+                                )
+                                .with_hint("a plan's times start at 0"));
+                        }
+                        return self
+                            .parenthesised(Some(0.0))
+                            .map(|s| Line::Step(PlanFormat::Timed, s));
+                    }
+                    self.pos = after_head;
+                }
                 if !head.starts_with(['+', '-']) && time.is_finite() {
                     self.skip_ws();
                     if self.peek() == Some(b'(') {
@@ -491,6 +512,24 @@ mod tests {
         assert_eq!(at, vec![("L001", 0), ("L001", 16), ("L001", 37)]);
     }
 
+    #[test]
+    fn a_negative_time_is_an_error_and_minus_zero_is_zero() {
+        let (plan, diags) = parse_plan("-0.000: (move a b) [1.000]\n-2.5: (move b a) [1.000]\n", 0);
+        assert_eq!(plan.steps.len(), 1);
+        assert_eq!(plan.steps[0].time, Some(0.0));
+        assert!(plan.steps[0].time.unwrap().is_sign_positive());
+        let at: Vec<_> = diags
+            .iter()
+            .map(|d| (d.code, d.span.start, d.span.end))
+            .collect();
+        assert_eq!(at, vec![("L001", 27, 31)]);
+        assert!(
+            diags[0].message.contains("negative time, `-2.5`"),
+            "{}",
+            diags[0].message
+        );
+    }
+
     /// Both readers on `text`, whole and line by line.
     fn assert_readers_agree(text: &str, what: &str) {
         assert_eq!(
@@ -567,6 +606,9 @@ mod tests {
         ".5: (move a b)",
         "+1: (move a b)",
         "-1: (move a b)",
+        "-0.000: (move a b) [1.000]",
+        "-0.5: (move a b) [1.000]",
+        "-1: move a b",
         "1e2: (move a b)",
         "1.2.3: (move a b)",
         "2.001: (PICK_OP1 robot1 screwdriver tool_rack) [3.000]",
