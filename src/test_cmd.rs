@@ -57,7 +57,14 @@ const PLANS: &str = "plans";
 
 /// Whether a file name is a plan's: `*.plan`, `*.tplan`, `plan.*`,
 /// `sas_plan*`.
+/// What a case's fault scenario is named after its plan's stem.
+const FAULTS: &str = ".faults.toml";
+
 fn is_plan(name: &str) -> bool {
+    // A case's fault scenario (`plan.faults.toml`) is not a case.
+    if name.ends_with(FAULTS) {
+        return false;
+    }
     name.ends_with(".plan")
         || name.ends_with(".tplan")
         || name.starts_with("plan.")
@@ -110,7 +117,23 @@ fn snapshot_content(text: &str) -> Option<&str> {
 /// in which steps start and end, faults, the final status and whether the
 /// goal holds. Ticks are left out: a snapshot of the order changes when
 /// the behaviour does, not when a node is added that takes no tick.
-fn run_text(ir: &btc_ir::TreeIr) -> anyhow::Result<String> {
+/// The fault scenario of a case: `STEM.faults.toml` beside its plan.
+fn scenario_of(plan: &Path) -> anyhow::Result<Option<(PathBuf, btc_runtime::Scenario)>> {
+    let path = plan.with_extension(&FAULTS[1..]);
+    if !path.is_file() {
+        return Ok(None);
+    }
+    let text =
+        crate::files::read_text(&path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let scenario = btc_runtime::Scenario::parse(&text)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    Ok(Some((path, scenario)))
+}
+
+fn run_text(
+    ir: &btc_ir::TreeIr,
+    faults: Option<&(PathBuf, btc_runtime::Scenario)>,
+) -> anyhow::Result<String> {
     let world = World::new(ir.world.clone()).map_err(anyhow::Error::msg)?;
     let doc = TreeDoc::from_ir(ir);
     let opts = Options {
@@ -119,6 +142,11 @@ fn run_text(ir: &btc_ir::TreeIr) -> anyhow::Result<String> {
     };
     let mut engine = Engine::build(&doc, Some(Kb::new(&world)), opts)
         .map_err(|e| anyhow::anyhow!("the tree does not load in the runtime: {}", e.message))?;
+    if let Some((path, scenario)) = faults {
+        engine
+            .add_faults(scenario)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    }
     let status = engine.run(100_000, |_| {});
     // The trace's step, fault and record events, in their order.
     let mut lines = Vec::new();
@@ -245,11 +273,12 @@ pub fn run(a: &TestArgs) -> anyhow::Result<ExitCode> {
             continue;
         };
         drop(job);
+        let faults = scenario_of(&dir.join(case))?;
         rules_cmd::record_paths_from(std::sync::Arc::make_mut(&mut ir), dir);
         for &target in &targets {
             let content = match target {
                 Target::Tree(f) => emit::emit(&ir, f, &emit::Options::default()),
-                Target::Run => run_text(&ir)?,
+                Target::Run => run_text(&ir, faults.as_ref())?,
             };
             let name = snapshot_name(rules_stem, case, target);
             let path = snapshots.join(&name);

@@ -213,3 +213,34 @@ fn cases_in_a_plans_folder_and_check_without_snapshots() {
         ]
     );
 }
+
+/// A case with a fault scenario beside its plan (`STEM.faults.toml`): its
+/// run snapshot holds the fault and the record it leaves; the scenario is
+/// not a case of its own.
+#[test]
+fn a_case_runs_with_the_fault_scenario_beside_its_plan() {
+    let dir = tempfile::tempdir().unwrap();
+    let cell = dir.path().join("ariac");
+    copy_example("ariac", &cell);
+    std::fs::copy(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/ariac/faults/robot_malfunction.toml"),
+        cell.join("plan.faults.toml"),
+    )
+    .unwrap();
+    let out = btc_in(&cell, &["test", "rules.btrules"]);
+    exits(&out, 0, "first run");
+    assert!(text(&out).contains("1 cases"), "{}", text(&out));
+    let run = std::fs::read_to_string(cell.join("snapshots/rules__plan.txt__run.snap")).unwrap();
+    assert!(run.contains("fault triggered"), "{run}");
+    assert!(run.contains("record"), "{run}");
+    assert!(run.contains("status: FAILURE"), "{run}");
+    // A broken scenario is an error that names it.
+    std::fs::write(cell.join("plan.faults.toml"), "[[fault]]\nkind = 3\n").unwrap();
+    let out = btc_in(&cell, &["test", "rules.btrules"]);
+    assert_ne!(out.status.code(), Some(0));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("plan.faults.toml"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
