@@ -11,7 +11,10 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ("btc-pddl", &[]),
     ("btc-ir", &["btc-pddl"]),
     ("btc-emit", &["btc-ir", "btc-pddl"]),
-    ("btc-lang", &["btc-ir", "btc-pddl", "btc-script"]),
+    (
+        "btc-lang",
+        &["btc-files", "btc-ir", "btc-pddl", "btc-script"],
+    ),
     ("btc-planner", &["btc-pddl"]),
     ("btc-runtime", &["btc-ir", "btc-pddl", "btc-script"]),
     (

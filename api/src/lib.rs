@@ -22,7 +22,6 @@
 
 mod agent;
 mod diagnostic;
-mod disk;
 mod faults;
 mod plan;
 mod project;

@@ -5,7 +5,6 @@
 //! memory ([`Project::from_texts`]).
 
 use crate::diagnostic::{convert, Diagnostic, Error};
-use crate::disk::Disk;
 use crate::plan::Plan;
 use crate::tree::Tree;
 use btc_lang::db::{self, CompileJob, Database, JobWorld};
@@ -13,6 +12,11 @@ use btc_lang::path::FilePath;
 use btc_lang::project::{self, FileLoader, JobPaths, MemoryLoader, PlanSource, ReadFailure};
 use btc_pddl::diagnostic::{codes, has_errors};
 use std::path::Path;
+
+/// The disk, read up to btc's file limit.
+const DISK: project::DiskLoader = project::DiskLoader {
+    limit: btc_pddl::source::MAX_FILE_BYTES,
+};
 
 /// Where the plan of a compile is kept in the database.
 const PLAN_FILE: &str = "<plan>";
@@ -31,7 +35,7 @@ enum Files {
 impl Files {
     fn loader(&self) -> &dyn FileLoader {
         match self {
-            Files::Disk => &Disk,
+            Files::Disk => &DISK,
             Files::Memory(m) => m,
         }
     }
@@ -55,7 +59,7 @@ impl Project {
     pub fn open(rules: impl AsRef<Path>) -> Result<Project, Error> {
         let rules = FilePath::new(rules.as_ref());
         let mut db = Database::new();
-        project::load_rules(&mut db, &Disk, &rules).map_err(|why| unreadable(&rules, &why))?;
+        project::load_rules(&mut db, &DISK, &rules).map_err(|why| unreadable(&rules, &why))?;
         Ok(Project {
             db,
             rules,
@@ -299,7 +303,7 @@ pub(crate) fn plan_files(domain: &Path, problem: &Path) -> Result<Plan, Error> {
     use btc_pddl::pipeline::{domain_unit, problem_unit};
     let mut sources = btc_pddl::source::Sources::new();
     let mut read = |p: &Path| -> Result<u32, Error> {
-        let loaded = Disk
+        let loaded = DISK
             .read(p)
             .map_err(|why| unreadable(&FilePath::new(p), &why))?;
         Ok(sources.add(p.display().to_string(), loaded.text))

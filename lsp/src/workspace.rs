@@ -7,49 +7,15 @@
 use crate::convert::LineIndex;
 use btc_lang::db::{file_id, Database, Db as _, SourceFile};
 use btc_lang::path::FilePath;
-use btc_lang::project::{self, FileLoader, Loaded, ReadFailure};
+use btc_lang::project::{self, FileLoader};
 use btc_pddl::diagnostic::Diagnostic;
 use std::collections::{BTreeMap, BTreeSet, HashSet};
-use std::path::{Path, PathBuf};
+
 use tower_lsp::lsp_types::TextDocumentContentChangeEvent;
 
 /// Files larger than this are not read from disk (the CLI's limit is 1 GiB;
 /// an editor has no use for more than this).
 const MAX_DISK_FILE: usize = 64 << 20;
-
-/// The disk as the language server reads it, through the CLI's bounded
-/// reader (devices and folders are refused, nothing is read past the
-/// limit). Open documents come from the editor instead.
-pub struct Disk;
-
-impl FileLoader for Disk {
-    fn read(&self, path: &Path) -> Result<Loaded, ReadFailure> {
-        match btc_files::read(path, MAX_DISK_FILE) {
-            Ok(bytes) => Ok(Loaded::from_bytes(&bytes)),
-            Err(btc_files::ReadError::Io(e)) if e.kind() == std::io::ErrorKind::NotFound => {
-                Err(ReadFailure::NotFound)
-            }
-            Err(e @ btc_files::ReadError::NotAFile { .. }) => Err(ReadFailure::NotAFile {
-                reason: e.to_string(),
-            }),
-            Err(e) => Err(ReadFailure::Unreadable {
-                reason: e.to_string(),
-            }),
-        }
-    }
-
-    fn list(&self, dir: &Path) -> Vec<PathBuf> {
-        let mut out: Vec<PathBuf> = std::fs::read_dir(dir)
-            .into_iter()
-            .flatten()
-            .filter_map(Result::ok)
-            .map(|e| e.path())
-            .filter(|p| p.is_file())
-            .collect();
-        out.sort();
-        out
-    }
-}
 
 pub struct Workspace {
     pub db: Database,
@@ -84,7 +50,9 @@ impl Default for Workspace {
 impl Workspace {
     /// A workspace over the disk.
     pub fn new() -> Workspace {
-        Workspace::with_loader(Box::new(Disk))
+        Workspace::with_loader(Box::new(project::DiskLoader {
+            limit: MAX_DISK_FILE,
+        }))
     }
 
     /// A workspace whose files not open in the editor come from `loader`.

@@ -1,6 +1,7 @@
-//! Where a project's files come from. The library reads nothing itself: the
-//! CLI and the language server give a [`FileLoader`] over the disk, tests a
-//! [`MemoryLoader`].
+//! Where a project's files come from: a [`FileLoader`]. The database reads
+//! nothing itself; the loaders are [`super::DiskLoader`] (the language server
+//! and the library facade), the CLI's own disk, and [`MemoryLoader`] (texts,
+//! tests).
 
 use crate::path::FilePath;
 use btc_pddl::source::{decode, DecodeProblem};

@@ -4,6 +4,7 @@
 //! report the same diagnostics in the same order ([`report`]). Which problem
 //! a plan goes with is decided here too ([`job`]).
 
+pub mod disk;
 pub mod fit;
 pub mod job;
 pub mod load;
@@ -12,6 +13,7 @@ pub mod nearby;
 pub mod refs;
 pub mod report;
 
+pub use disk::DiskLoader;
 pub use job::{load_job, JobPaths, LoadedJob, PlanSource, ProblemChoice};
 pub use load::{load_file, load_references, load_rules, read_file};
 pub use loader::{FileLoader, Loaded, MemoryLoader, ReadFailure};

@@ -1,14 +1,20 @@
-//! The disk as a project reads it: through btc's bounded reader (folders and
-//! devices refused, nothing read past btc's file limit).
+//! The disk as a project loader reads it, through btc's bounded reader:
+//! folders and devices are refused, and nothing is read past `limit`
+//! bytes. The language server and the library facade load projects with
+//! it (the CLI keeps its own, which reads an over-long file as a
+//! diagnostic instead of a failure).
 
-use btc_lang::project::{FileLoader, Loaded, ReadFailure};
+use super::loader::{FileLoader, Loaded, ReadFailure};
 use std::path::{Path, PathBuf};
 
-pub(crate) struct Disk;
+pub struct DiskLoader {
+    /// The largest file read, in bytes.
+    pub limit: usize,
+}
 
-impl FileLoader for Disk {
+impl FileLoader for DiskLoader {
     fn read(&self, path: &Path) -> Result<Loaded, ReadFailure> {
-        match btc_files::read(path, btc_pddl::source::MAX_FILE_BYTES) {
+        match btc_files::read(path, self.limit) {
             Ok(bytes) => Ok(Loaded::from_bytes(&bytes)),
             Err(btc_files::ReadError::Io(e)) if e.kind() == std::io::ErrorKind::NotFound => {
                 Err(ReadFailure::NotFound)
