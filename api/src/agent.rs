@@ -125,7 +125,7 @@ impl Agent {
             &mut std::io::sink(),
             Some(&mut install),
         );
-        self.report(result, faults)
+        report(&self.project, result, faults)
     }
 
     /// Runs the loop with every attempt's tree ticked by `executor` (the
@@ -139,42 +139,58 @@ impl Agent {
         options: &AgentOptions,
         executor: &mut dyn Executor,
     ) -> Result<AgentReport, Error> {
+        let problem = self.problem.clone();
+        self.project
+            .run_agent(problem.as_deref(), options, executor)
+    }
+}
+
+impl Project {
+    /// [`Agent::run_with`] on this project, for `problem` (a path; `None`:
+    /// the project's problem), without giving the project up: the
+    /// compile jobs it keeps serve the loop's plans and later calls alike.
+    pub fn run_agent(
+        &mut self,
+        problem: Option<&Path>,
+        options: &AgentOptions,
+        executor: &mut dyn Executor,
+    ) -> Result<AgentReport, Error> {
         let opts = loop_options(options);
-        let (db, job) = self.project.loop_job(self.problem.as_deref())?;
+        let (db, job) = self.loop_job(problem)?;
         let mut adapter = Adapter { executor };
         let result = btc_agent::run_loop_outside(db, job, &opts, &mut adapter);
-        self.report(result, None)
+        report(self, result, None)
     }
+}
 
-    fn report(
-        &self,
-        result: Result<btc_agent::LoopSummary, LoopError>,
-        faults: Option<&Faults>,
-    ) -> Result<AgentReport, Error> {
-        let summary = match result {
-            Ok(s) => s,
-            Err(LoopError::Compile(ds)) => return Err(self.project.error(&ds)),
-            Err(LoopError::Tree(e)) => return Err(crate::faults::load_error(&e, "<tree>")),
-            Err(LoopError::Scenario(e)) => {
-                return Err(match faults {
-                    Some(f) => f.error(&e),
-                    None => crate::faults::load_error(&e, "<faults>"),
-                })
-            }
-        };
-        let sources = self.project.sources_for(&summary.diagnostics);
-        Ok(AgentReport {
-            attempts: summary.attempts,
-            replans: summary.replans,
-            faults: summary.faults,
-            goal: summary.goal,
-            goal_reached: summary.goal_reached,
-            goal_failure: summary.goal_failure,
-            ticks: summary.ticks,
-            stopped: convert(&summary.diagnostics, &sources),
-            unreachable: summary.unreachable,
-        })
-    }
+fn report(
+    project: &Project,
+    result: Result<btc_agent::LoopSummary, LoopError>,
+    faults: Option<&Faults>,
+) -> Result<AgentReport, Error> {
+    let summary = match result {
+        Ok(s) => s,
+        Err(LoopError::Compile(ds)) => return Err(project.error(&ds)),
+        Err(LoopError::Tree(e)) => return Err(crate::faults::load_error(&e, "<tree>")),
+        Err(LoopError::Scenario(e)) => {
+            return Err(match faults {
+                Some(f) => f.error(&e),
+                None => crate::faults::load_error(&e, "<faults>"),
+            })
+        }
+    };
+    let sources = project.sources_for(&summary.diagnostics);
+    Ok(AgentReport {
+        attempts: summary.attempts,
+        replans: summary.replans,
+        faults: summary.faults,
+        goal: summary.goal,
+        goal_reached: summary.goal_reached,
+        goal_failure: summary.goal_failure,
+        ticks: summary.ticks,
+        stopped: convert(&summary.diagnostics, &sources),
+        unreachable: summary.unreachable,
+    })
 }
 
 fn loop_options(options: &AgentOptions) -> LoopOptions {

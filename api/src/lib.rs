@@ -51,3 +51,9 @@ pub fn plan(
 ) -> Result<Plan, Error> {
     project::plan_files(domain.as_ref(), problem.as_ref())
 }
+
+/// The Rust examples of docs/embedding.md, compiled as doc tests so that
+/// the page keeps up with the API.
+#[cfg(doctest)]
+#[doc = include_str!("../../docs/embedding.md")]
+pub struct EmbeddingGuide;

@@ -95,6 +95,14 @@ def _show(key):
     return "(" + " ".join(key) + ")"
 
 
+def _key(text):
+    """A fact written `(on p bin1)` as the knowledge base keeps it."""
+    words = text.strip().removeprefix("(").removesuffix(")").split()
+    if not words:
+        raise ValueError("`%s` is not a fact such as `(on p bin1)`" % text)
+    return tuple(words)
+
+
 # ---------------------------------------------------------------------------
 # The world: types, objects, signatures, derived rules, initial state
 
@@ -228,6 +236,7 @@ class KnowledgeBase:
         self.finished = [False] * len(self.plan.steps)
         self.tick = 0
         self.events = []
+        self.faults = []
 
     def now_ms(self):
         """The clock `Timeout` reads: simulated (ms_per_tick per tick) unless
@@ -377,6 +386,31 @@ class KnowledgeBase:
                 self.derived.update(found)
 
     # -- reports
+
+    def report_fault(self, kind, reporter=None, **fields):
+        """A behaviour reports one of the eight ARIAC 2023 faults (kind:
+        ``faulty_part``, ``faulty_gripper``, ``robot_malfunction``,
+        ``flipped_part``, ``sensor_blackout``, ``high_priority_order``,
+        ``insufficient_parts``, ``human_too_close``), with what a fault
+        scenario says of it: ``robot``, ``part``, ``duration`` (ticks),
+        ``retract`` and ``add`` (facts as text, ``"(on p bin1)"``), ``goal``
+        (an order's), ``name``. What it changes applies now, as btc's engine
+        applies a scenario's fault: its ``retract`` and ``add`` facts, or
+        for a faulty or missing part without ``retract``, every fact that
+        names the part (it is gone). ``btc.Agent`` takes the reports to
+        replan as ``btc run --replan`` does."""
+        fault = dict(fields, kind=kind, tick=self.tick)
+        if reporter is not None:
+            fault["reporter"] = reporter
+        retract = [_key(t) for t in fields.get("retract") or ()]
+        if not retract and kind in ("faulty_part", "insufficient_parts") and fields.get("part"):
+            retract = [f for f in self.facts if fields["part"] in f[1:]]
+        for key in retract:
+            self.facts.discard(key)
+        self.facts.update(_key(t) for t in fields.get("add") or ())
+        self.close_derived()
+        self.faults.append(fault)
+        return fault
 
     def goal_reached(self):
         """Whether the problem's goal holds (True when it has none)."""
@@ -580,6 +614,16 @@ class Action(KbBehaviour):
     def initialise(self):
         self._left = self.kb.ticks_per_action
         self._fresh = True
+
+    def report_fault(self, kind, reason=None, **fields):
+        """Reports a fault this action met (see
+        ``KnowledgeBase.report_fault``) and returns FAILURE, for ``return
+        self.report_fault("faulty_gripper", robot="floor_robot", reason="the
+        gripper dropped the part")`` in ``update()``."""
+        self.kb.report_fault(kind, reporter=self.name, **fields)
+        if reason:
+            self.feedback_message = reason
+        return Status.FAILURE
 
     def update(self):
         if self._fresh:

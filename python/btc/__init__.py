@@ -17,6 +17,14 @@ and where (code, severity, message, path, line, column, hint).
 ``btc compile --emit pytrees --runtime import`` writes import.
 """
 
+from ._agent import (
+    Agent,
+    AgentReport,
+    Attempt,
+    FaultOutcome,
+    Record,
+    Replan,
+)
 from ._btc import (
     BtcError,
     Diagnostic,
@@ -29,7 +37,13 @@ from ._btc import (
 )
 
 __all__ = [
+    "Agent",
+    "AgentReport",
+    "Attempt",
     "BtcError",
+    "FaultOutcome",
+    "Record",
+    "Replan",
     "Diagnostic",
     "Plan",
     "Project",

@@ -1,7 +1,7 @@
 """Type stubs of btc's native module (re-exported by ``btc``)."""
 
 import os
-from typing import Union
+from typing import Any, Callable, Union
 
 import py_trees
 
@@ -63,5 +63,12 @@ class Project:
     def check(self) -> list[Diagnostic]: ...
     def plan(self, problem: StrPath | None = None) -> Plan: ...
     def compile(self, plan: Plan, problem: StrPath | None = None) -> Tree: ...
+    def _run_agent(
+        self,
+        execute: Callable[[dict[str, Any]], dict[str, Any]],
+        problem: StrPath | None = None,
+        max_replans: int = 5,
+        max_ticks: int = 100000,
+    ) -> str: ...
 
 def plan(domain: StrPath, problem: StrPath) -> Plan: ...

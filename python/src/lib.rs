@@ -3,6 +3,8 @@
 //! Python values go out; bad input raises `btc.BtcError` carrying the
 //! diagnostics, never a crash of the host process.
 
+mod agent;
+
 use btc_api as api;
 use pyo3::create_exception;
 use pyo3::exceptions::PyException;
@@ -92,7 +94,7 @@ impl From<&api::Diagnostic> for Diagnostic {
 }
 
 /// `btc.BtcError(message, diagnostics)`, raised.
-fn raise(py: Python<'_>, e: api::Error) -> PyErr {
+pub(crate) fn raise(py: Python<'_>, e: api::Error) -> PyErr {
     let diags: Vec<Diagnostic> = e.diagnostics.iter().map(Diagnostic::from).collect();
     let err = BtcError::new_err(e.to_string());
     match diags.into_pyobject(py) {
@@ -191,14 +193,14 @@ impl Plan {
 
 /// A compiled tree, in each of btc's output forms.
 #[pyclass(module = "btc", frozen)]
-struct Tree {
+pub(crate) struct Tree {
     tree: api::Tree,
     /// The py_trees module read as data (`btc._pytrees.TreeData`), once.
     data: std::sync::OnceLock<Py<PyAny>>,
 }
 
 impl Tree {
-    fn new(tree: api::Tree) -> Tree {
+    pub(crate) fn new(tree: api::Tree) -> Tree {
         Tree {
             tree,
             data: std::sync::OnceLock::new(),
@@ -327,6 +329,27 @@ impl Project {
             .plan(problem.as_deref())
             .map(|plan| Plan { plan })
             .map_err(|e| raise(py, e))
+    }
+
+    /// The closed loop for `problem`, each attempt run by `execute(attempt)
+    /// -> dict` (`btc.Agent` is the way to call it): the report as JSON.
+    #[pyo3(signature = (execute, problem=None, max_replans=5, max_ticks=100_000))]
+    fn _run_agent(
+        &mut self,
+        py: Python<'_>,
+        execute: Bound<'_, PyAny>,
+        problem: Option<PathBuf>,
+        max_replans: usize,
+        max_ticks: u64,
+    ) -> PyResult<String> {
+        agent::run(
+            &mut self.project,
+            py,
+            execute,
+            problem,
+            max_replans,
+            max_ticks,
+        )
     }
 
     /// Compiles `plan` with the rules for `problem`.
