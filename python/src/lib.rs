@@ -370,6 +370,14 @@ fn plan(py: Python<'_>, domain: PathBuf, problem: PathBuf) -> PyResult<Plan> {
         .map_err(|e| raise(py, e))
 }
 
+/// The `btc` command (`args`: the command line, program name first): its
+/// exit status. What it prints goes to this process's stdout and stderr.
+#[pyfunction]
+fn _main(py: Python<'_>, args: Vec<std::ffi::OsString>) -> u8 {
+    // Long commands (a trial, the language server) must not hold the GIL.
+    py.detach(|| btc::exit_status(btc::run(args)))
+}
+
 #[pymodule]
 fn _btc(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", api::VERSION)?;
@@ -380,5 +388,6 @@ fn _btc(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Tree>()?;
     m.add_class::<Project>()?;
     m.add_function(wrap_pyfunction!(plan, m)?)?;
+    m.add_function(wrap_pyfunction!(_main, m)?)?;
     Ok(())
 }

@@ -269,3 +269,37 @@ def test_ten_thousand_rounds_keep_the_blackboard_and_memory_flat():
     assert len(clients) == settled
     grown = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - rss
     assert grown < 16 * 1024, f"resident memory grew by {grown} KiB over 9,500 rounds"
+
+
+def test_the_package_is_a_complete_install_with_the_btc_command():
+    """`pip install` puts `btc` on the PATH: btc's command line, the same
+    binary's code, run by the package's native module."""
+    import importlib.metadata
+
+    scripts = [
+        e for e in importlib.metadata.entry_points(group="console_scripts") if e.name == "btc"
+    ]
+    installed = [e for e in scripts if e.value == "btc._cli:main"]
+    if not installed:
+        if os.environ.get("CI") == "true":
+            pytest.fail("the installed package has no `btc` command")
+        pytest.skip("the package is not installed (run from the source folder)")
+    command = pathlib.Path(sys.executable).parent / "btc"
+    assert command.exists(), command
+    version = subprocess.run([command, "--version"], capture_output=True, text=True, check=False)
+    assert version.returncode == 0
+    assert version.stdout.strip() == f"btc {btc.__version__}"
+    rules = ROOT / "examples" / "ariac" / "rules.btrules"
+    ours = subprocess.run(
+        [command, "compile", rules, "--emit", "btcpp"], capture_output=True, text=True, check=False
+    )
+    theirs = run_btc("compile", str(rules), "--emit", "btcpp")
+    assert ours.returncode == 0, ours.stderr
+    assert ours.stdout == theirs
+    # Bad input: the command's own error and exit status, no traceback.
+    bad = subprocess.run(
+        [command, "check", ROOT / "no_such.btrules"], capture_output=True, text=True, check=False
+    )
+    assert bad.returncode == 2
+    assert "F001" in bad.stderr or "cannot read" in bad.stderr, bad.stderr
+    assert "Traceback" not in bad.stderr
