@@ -207,3 +207,20 @@ def test_a_dropped_part_is_picked_again():
     assert report.attempts[0].records[0].node_id == "Grasp"
     assert report.attempts[0].records[0].reason == "the gripper dropped the part"
     assert report.attempts[0].records[0].faults == ["faulty_gripper"]
+
+
+def test_the_embedding_example_recovers_from_its_fault():
+    """examples/embed/python: an action-client behaviour, a faulty part, a
+    replan with the spare."""
+    out = subprocess.run(
+        [sys.executable, str(ROOT / "examples" / "embed" / "python" / "agent.py")],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert out.returncode == 0, out.stdout + out.stderr
+    assert "replanned after attempt 1" in out.stdout
+    assert "(grasp floor_robot battery_red_2 bin5)" in out.stdout
+    assert "goal (on battery_red_2 agv1): reached" in out.stdout
+    assert "fault faulty_part: recovered" in out.stdout
