@@ -470,3 +470,64 @@ fn a_report_the_loop_cannot_take_is_an_error_with_diagnostics() {
         assert!(!err.diagnostics.is_empty());
     }
 }
+
+/// Writes each attempt's knowledge base and goal as a PDDL problem, plans
+/// it in a project of its own, then runs the attempt as `ReportingEngine`.
+struct WritingProblems {
+    inner: ReportingEngine,
+    project: Project,
+    /// The plans the written problems gave, and the attempts' own.
+    plans: Vec<(Vec<String>, Vec<String>)>,
+}
+
+impl Executor for WritingProblems {
+    fn execute(&mut self, a: &AttemptInput) -> Result<Executed, String> {
+        let text = self
+            .project
+            .problem_text(&a.state, &a.goal, None)
+            .map_err(|e| e.to_string())?;
+        let own = Project::from_texts(
+            &read("examples/ariac/rules.btrules"),
+            &read("examples/ariac/domain.pddl"),
+            Some(&text),
+        )
+        .map_err(|e| e.to_string())?
+        .plan(None)
+        .map_err(|e| format!("{e}\n{text}"))?;
+        let steps = own.steps.iter().map(|s| s.to_string()).collect();
+        self.plans.push((steps, a.tree.steps()));
+        self.inner.execute(a)
+    }
+}
+
+#[test]
+fn the_knowledge_base_written_as_a_problem_plans_as_the_loop_does() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let faults = Faults::open(root.join("examples/ariac/faults/flipped_part.toml")).unwrap();
+    let mut executor = WritingProblems {
+        inner: ReportingEngine {
+            faults: Some(faults),
+        },
+        project: open("ariac"),
+        plans: Vec::new(),
+    };
+    let mut agent = Agent::new(open("ariac"), None);
+    let report = agent
+        .run_with(&AgentOptions::default(), &mut executor)
+        .unwrap();
+    assert!(report.goal_reached, "{report:#?}");
+    assert_eq!(executor.plans.len(), 2, "one replan after the flip");
+    for (written, loop_plan) in &executor.plans {
+        assert_eq!(written, loop_plan);
+    }
+    // What it cannot write is an error, not a line of the problem.
+    let mut p = open("ariac");
+    let err = p
+        .problem_text(
+            &["(on battery_red the_moon)".into()],
+            "(on battery_red agv1)",
+            None,
+        )
+        .unwrap_err();
+    assert!(err.to_string().contains("the_moon"), "{err}");
+}

@@ -147,7 +147,7 @@ impl ReportedFault {
 }
 
 /// A KB entry as the executor wrote it: `(p a b)` or `(= (f a) 3)`.
-fn fact(text: &str) -> Result<InitFact, String> {
+pub(crate) fn fact(text: &str) -> Result<InitFact, String> {
     let bad = |m: String| format!("`{text}` is not a fact or a fluent value: {m}");
     match decode::formula(text).map_err(bad)? {
         Formula::Atom(a) => Ok(InitFact::Atom(a)),

@@ -147,6 +147,54 @@ impl Project {
         }
     }
 
+    /// `problem` (a path; `None` as for [`Project::plan`]) written back as
+    /// PDDL with `state` as its initial state and `goal` as its goal: the
+    /// knowledge base an agent holds (an [`crate::AttemptInput`]'s `state`
+    /// and `goal`, or facts from perception) as a problem any planner
+    /// reads. Facts are checked against the problem: a predicate, object
+    /// or fluent it does not have is an error, not a line in the output.
+    pub fn problem_text(
+        &mut self,
+        state: &[String],
+        goal: &str,
+        problem: Option<&Path>,
+    ) -> Result<String, Error> {
+        let job = self.job(problem)?;
+        self.refuse_errors(job, |d| d.span.file != self.plan_id(job))?;
+        let w = self.world_of(job)?;
+        let world = w.world().map_err(|m| {
+            Error::one(Diagnostic::without_place(
+                codes::X_WORLD.id,
+                format!("the problem's world does not fit together: {m}"),
+                &self.rules.to_string(),
+            ))
+        })?;
+        let bad = |m: String| {
+            Error::one(Diagnostic::without_place(
+                codes::X_KB.id,
+                m,
+                &self.rules.to_string(),
+            ))
+        };
+        let mut init = Vec::with_capacity(state.len());
+        for text in state {
+            let fact = crate::executor::fact(text).map_err(&bad)?;
+            let known = match &fact {
+                btc_pddl::logic::InitFact::Atom(a) => world.atom_key(a).map(drop),
+                btc_pddl::logic::InitFact::Value(a, _) => world.fluent_key(a).map(drop),
+            };
+            known.map_err(|m| bad(format!("`{text}`: {m}")))?;
+            init.push(fact);
+        }
+        let goal = btc_pddl::logic::decode::formula(goal)
+            .map_err(|m| bad(format!("the goal `{goal}` is not a PDDL condition: {m}")))?;
+        Ok(btc_pddl::problem_text::problem_text(
+            w.problem,
+            &init,
+            Some(&goal),
+        ))
+    }
+
     /// Compiles `plan` with the rules for `problem` (as [`Project::plan`]
     /// chooses it): the plan is typed against the problem and replayed on
     /// it first, as `btc compile` does, and refused when it does not fit.

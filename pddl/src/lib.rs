@@ -18,6 +18,7 @@ pub mod parse;
 pub mod pipeline;
 pub mod plan;
 pub mod print;
+pub mod problem_text;
 pub mod render;
 pub mod sexpr;
 pub mod source;

@@ -80,7 +80,10 @@ impl PyExecutor<'_> {
             state: out.get_item("state")?.extract()?,
             ticks: out.get_item("ticks")?.extract()?,
             steps_done: opt(&out, "steps_done")?.unwrap_or_default(),
-            records: list("records")?.iter().map(record).collect::<PyResult<_>>()?,
+            records: list("records")?
+                .iter()
+                .map(record)
+                .collect::<PyResult<_>>()?,
             faults: list("faults")?.iter().map(fault).collect::<PyResult<_>>()?,
         })
     }
