@@ -159,18 +159,12 @@ impl Reader {
             let x = x as u8;
             if let Some(first) = taken.get(&(bin, x)) {
                 let first = *first;
-                self.error(
-                    codes::TRIAL_DUPLICATE,
+                self.twice(
                     s.range,
                     format!("slot {x} of `{name}` holds a part already"),
+                    first,
+                    "given here first",
                 );
-                let sp = self.span(first);
-                if let Some(d) = self.diags.last_mut() {
-                    d.labels.push(btc_pddl::diagnostic::Label {
-                        span: sp,
-                        message: "given here first".into(),
-                    });
-                }
                 continue;
             }
             taken.insert((bin, x), s.range);

@@ -58,6 +58,17 @@ impl Reader {
         self.diags.last_mut().expect("just pushed")
     }
 
+    /// T006 for something given twice, labelled where it was given first.
+    pub(super) fn twice(&mut self, r: Range, msg: impl Into<String>, first: Range, label: &str) {
+        let first = self.span(first);
+        self.error(codes::TRIAL_DUPLICATE, r, msg)
+            .labels
+            .push(btc_pddl::diagnostic::Label {
+                span: first,
+                message: label.into(),
+            });
+    }
+
     pub(super) fn warn(&mut self, code: Code, r: Range, msg: impl Into<String>) -> &mut Diagnostic {
         self.diags
             .push(Diagnostic::warning(code, self.span(r), msg.into()));

@@ -21,21 +21,15 @@ impl Reader {
             };
             if let Some(first) = out.iter().find(|x| x.id == order.id) {
                 let first = first.range;
-                self.error(
-                    codes::TRIAL_DUPLICATE,
+                self.twice(
                     o.range,
                     format!(
                         "order id `{}` is given twice; each order needs its own",
                         order.id
                     ),
+                    first,
+                    "the first order with this id",
                 );
-                let sp = self.span(first);
-                if let Some(d) = self.diags.last_mut() {
-                    d.labels.push(btc_pddl::diagnostic::Label {
-                        span: sp,
-                        message: "the first order with this id".into(),
-                    });
-                }
                 continue;
             }
             out.push(order);
