@@ -87,6 +87,20 @@ fn starting_with<'a>(sorted: &'a [(SmolStr, usize)], prefix: &str) -> &'a [(Smol
     &sorted[from..from + len]
 }
 
+/// The domain actions a rule pattern's name matches, with their captures
+/// (in domain order).
+pub fn matched_actions<'d>(
+    pattern: &Pattern,
+    domain: &'d Domain,
+    actions: &ActionIndex,
+) -> Vec<(&'d btc_pddl::ast::Action, Captures)> {
+    actions
+        .matches(&pattern.name, domain)
+        .into_iter()
+        .map(|(i, c)| (&domain.actions[i], c))
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -126,18 +140,4 @@ mod tests {
             assert_eq!(ix.matches(&ps, &domain), scan, "{p}");
         }
     }
-}
-
-/// The domain actions a rule pattern's name matches, with their captures
-/// (in domain order).
-pub fn matched_actions<'d>(
-    pattern: &Pattern,
-    domain: &'d Domain,
-    actions: &ActionIndex,
-) -> Vec<(&'d btc_pddl::ast::Action, Captures)> {
-    actions
-        .matches(&pattern.name, domain)
-        .into_iter()
-        .map(|(i, c)| (&domain.actions[i], c))
-        .collect()
 }

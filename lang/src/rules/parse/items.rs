@@ -250,16 +250,14 @@ fn guard<'t, I: Tokens<'t>, R: ItemError<'t, I> + 't>(
         .labelled("a variable or an object name in quotes");
     choice((
         operand
-            .clone()
             .then_ignore(punct("!="))
-            .then(operand.clone())
+            .then(operand)
             .map_with(move |(left, right), e| Guard::Ne {
                 left,
                 right,
                 span: sp(e.span()),
             }),
         operand
-            .clone()
             .then_ignore(punct("=="))
             .then(operand)
             .map_with(move |(left, right), e| Guard::Eq {
