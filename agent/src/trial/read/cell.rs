@@ -244,13 +244,8 @@ impl Reader {
                 None => 1.0,
             },
             None if active => {
-                let at = Range {
-                    start: node.range.start,
-                    end: node.range.start,
-                };
-                self.error(
-                    codes::TRIAL_MISSING,
-                    at,
+                self.missing(
+                    node,
                     "an active `conveyor_belt` needs `spawn_rate` (seconds between parts)",
                 );
                 1.0

@@ -23,15 +23,7 @@ impl Reader {
             );
         }
         let Some(first) = given.first() else {
-            let at = Range {
-                start: f.node.range.start,
-                end: f.node.range.start,
-            };
-            self.error(
-                codes::TRIAL_MISSING,
-                at,
-                format!("{what} has no condition: give `time_condition`, `part_place_condition` or `submission_condition`"),
-            );
+            self.missing(f.node, format!("{what} has no condition: give `time_condition`, `part_place_condition` or `submission_condition`"));
             return None;
         };
         let n = f.get(first).expect("present");

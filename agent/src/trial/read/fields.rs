@@ -102,18 +102,22 @@ impl Reader {
     pub(super) fn need<'a>(&mut self, f: &mut Fields<'a>, key: &str) -> Option<&'a Node> {
         let v = f.get(key);
         if v.is_none() {
-            let at = Range {
-                start: f.node.range.start,
-                end: f.node.range.start,
-            };
-            let what = f.what.clone();
-            self.error(
-                codes::TRIAL_MISSING,
-                at,
-                format!("{what} has no `{key}`, which the ARIAC 2023 trial format requires"),
+            let message = format!(
+                "{} has no `{key}`, which the ARIAC 2023 trial format requires",
+                f.what
             );
+            self.missing(f.node, message);
         }
         v
+    }
+
+    /// T002 at the start of `node`: something it should have is not there.
+    pub(super) fn missing(&mut self, node: &Node, msg: impl Into<String>) {
+        let at = Range {
+            start: node.range.start,
+            end: node.range.start,
+        };
+        self.error(codes::TRIAL_MISSING, at, msg);
     }
 
     /// Keys nobody asked for: not in the format (T004, a warning).

@@ -53,13 +53,8 @@ impl Reader {
         let priority = match f.get("priority") {
             Some(n) => self.boolean(n, "`priority`").unwrap_or(false),
             None => {
-                let at = Range {
-                    start: node.range.start,
-                    end: node.range.start,
-                };
-                self.error(
-                    codes::TRIAL_MISSING,
-                    at,
+                self.missing(
+                    node,
                     format!("{what} has no `priority` (`true` or `false`)"),
                 );
                 false
@@ -87,15 +82,7 @@ impl Reader {
         let given: Vec<&str> = tasks.iter().copied().filter(|k| f.has(k)).collect();
         let task = match (ty, given.as_slice()) {
             (_, []) => {
-                let at = Range {
-                    start: node.range.start,
-                    end: node.range.start,
-                };
-                self.error(
-                    codes::TRIAL_MISSING,
-                    at,
-                    format!("{what} has no task: give `kitting_task`, `assembly_task` or `combined_task`"),
-                );
+                self.missing(node, format!("{what} has no task: give `kitting_task`, `assembly_task` or `combined_task`"));
                 None
             }
             (_, [one]) => {
