@@ -3,6 +3,7 @@
 pub mod actions;
 pub mod ast;
 pub mod check;
+pub mod decls;
 pub mod file_checks;
 pub mod fmt;
 pub mod lexer;

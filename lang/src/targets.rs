@@ -180,16 +180,11 @@ fn tree_uses(ir: &TreeIr) -> TreeUses {
 
 /// Every decorator in a template, with the span of its keyword.
 fn decorators_in(t: &Template, out: &mut Vec<(DecoratorName, Span)>) {
-    match t {
-        Template::Control { children, .. } => {
-            children.iter().for_each(|c| decorators_in(c, out));
-        }
-        Template::Decorator {
-            decorator,
-            child,
-            span,
-            ..
-        } => {
+    t.walk(&mut |t| {
+        if let Template::Decorator {
+            decorator, span, ..
+        } = t
+        {
             let word = decorator.keyword().len() as u32;
             out.push((
                 *decorator,
@@ -198,13 +193,8 @@ fn decorators_in(t: &Template, out: &mut Vec<(DecoratorName, Span)>) {
                     ..*span
                 },
             ));
-            decorators_in(child, out);
         }
-        Template::Call { .. }
-        | Template::Script { .. }
-        | Template::Steps { .. }
-        | Template::Error { .. } => {}
-    }
+    });
 }
 
 /// The templates of an item: a rule's body, a tree's, the plan's.
@@ -231,9 +221,7 @@ enum Use {
 /// Every call and script attribute in a template, with the span of its
 /// name or attribute.
 fn calls(t: &Template, out: &mut Vec<(Use, Span)>) {
-    match t {
-        Template::Control { children, .. } => children.iter().for_each(|c| calls(c, out)),
-        Template::Decorator { child, .. } => calls(child, out),
+    t.walk(&mut |t| match t {
         Template::Call { name, scripts, .. } => {
             out.push((Use::Call(name.key.clone()), name.span));
             for a in scripts {
@@ -252,6 +240,9 @@ fn calls(t: &Template, out: &mut Vec<(Use, Span)>) {
             };
             out.push((Use::Call(Key::new(id)), *span));
         }
-        Template::Steps { .. } | Template::Error { .. } => {}
-    }
+        Template::Control { .. }
+        | Template::Decorator { .. }
+        | Template::Steps { .. }
+        | Template::Error { .. } => {}
+    });
 }

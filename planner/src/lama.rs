@@ -18,7 +18,8 @@ use crate::heuristic::{Costs, Evaluator, Heuristic};
 use crate::landmarks::LandmarkGraph;
 use crate::lazy::{Config, Counts, Lazy, Limits, Outcome};
 use crate::lmcount::LmCount;
-use crate::search::{SearchResult, SearchStats, Successors};
+use crate::options::{SearchResult, SearchStats};
+use crate::space::Successors;
 use crate::task::Task;
 use std::time::Instant;
 

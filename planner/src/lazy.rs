@@ -14,7 +14,7 @@
 
 use crate::heuristic::Evaluator;
 use crate::lmcount::LmCount;
-use crate::search::{Registry, Successors};
+use crate::space::{Registry, Successors};
 use crate::task::{AxiomScratch, Task};
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;

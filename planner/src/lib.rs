@@ -45,8 +45,10 @@ pub mod lazy;
 pub mod lifted;
 pub mod lmcount;
 pub mod lmcut;
+pub mod options;
 mod reach;
 pub mod search;
+pub mod space;
 pub mod task;
 
 pub use ground::GroundStats;

@@ -2,181 +2,15 @@
 //! (with a second open list for preferred operators when the heuristic
 //! gives them) and A* (reopening states reached more cheaply).
 
+pub use crate::options::{Algorithm, Options, SearchResult, SearchStats, DEFAULT_IMPROVE};
+pub use crate::space::Successors;
+
 use crate::heuristic::{Evaluator, Heuristic};
-use crate::task::{holds, test, AxiomScratch, Task};
-use hashbrown::HashTable;
+use crate::space::Registry;
+use crate::task::{AxiomScratch, Task};
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
-use std::hash::BuildHasher;
-use std::time::{Duration, Instant};
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Algorithm {
-    /// LAMA's search: lazy greedy search with h_FF, landmarks and preferred
-    /// operators, then restarts that improve the plan within
-    /// [`Options::improve`] ([`crate::lama`]). The heuristic option is not
-    /// used.
-    Lama,
-    /// Eager greedy best-first search: fast, not necessarily optimal.
-    Gbfs,
-    /// A*: optimal with an admissible heuristic.
-    Astar,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Options {
-    pub algorithm: Algorithm,
-    pub heuristic: Heuristic,
-    /// Stop after this long (with `Lama`, the best plan found by then is
-    /// the answer).
-    pub timeout: Option<Duration>,
-    /// `Lama`: the work the restarts may spend improving the first plan
-    /// ([`crate::lazy::Counts::work`]: about the facts, relaxed operators
-    /// and state words visited).
-    /// A measure of work rather than time keeps the plan the same on every
-    /// machine; 0 stops at the first plan.
-    pub improve: u64,
-}
-
-/// The default base budget of the restarts (plus four times the first
-/// search's work): a tenth to a third of a second, see docs/planner.md. Enough
-/// for the restarts to match or beat lama-first's costs on the corpus and
-/// the held-out problems (barman/p02 needs it: 106 with 10M or 20M, 94
-/// with 30M).
-pub const DEFAULT_IMPROVE: u64 = 30_000_000;
-
-impl Default for Options {
-    fn default() -> Self {
-        Options {
-            algorithm: Algorithm::Lama,
-            heuristic: Heuristic::Ff,
-            timeout: None,
-            improve: DEFAULT_IMPROVE,
-        }
-    }
-}
-
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct SearchStats {
-    /// The heuristic used (LM-cut falls back to h_max where it does not apply).
-    pub heuristic: Option<Heuristic>,
-    pub expanded: usize,
-    pub generated: usize,
-    pub evaluated: usize,
-    pub time: Duration,
-    /// `Lama`: searches run, the cost of the first plan, and whether a
-    /// search proved the last plan optimal.
-    pub iterations: usize,
-    pub first_cost: Option<u64>,
-    pub proved_optimal: bool,
-    /// `Lama`: the work done ([`crate::lazy::Counts::work`]).
-    pub work: u64,
-}
-
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub enum SearchResult {
-    /// Operator indexes, in order, and their total cost.
-    Plan(Vec<u32>, u64),
-    /// The search space is exhausted (or the relaxation proves it).
-    Unsolvable,
-    Timeout,
-}
-
-/// The applicable operators of a state, found through one trigger fact per
-/// operator instead of a scan of all operators.
-pub struct Successors {
-    by_fact: Vec<Vec<u32>>,
-    always: Vec<u32>,
-}
-
-impl Successors {
-    pub fn new(task: &Task) -> Successors {
-        let mut by_fact = vec![Vec::new(); task.num_facts()];
-        let mut always = Vec::new();
-        for (i, o) in task.operators.iter().enumerate() {
-            // Prefer a condition that is false initially: it is more often
-            // false, so the operator is looked at less often.
-            let pos = o.pre.iter().filter(|l| l.positive);
-            let trigger = pos
-                .clone()
-                .find(|l| !test(&task.init, l.fact))
-                .or_else(|| pos.clone().next());
-            match trigger {
-                Some(l) => by_fact[l.fact as usize].push(i as u32),
-                None => always.push(i as u32),
-            }
-        }
-        Successors { by_fact, always }
-    }
-
-    pub fn applicable(&self, task: &Task, s: &[u64], out: &mut Vec<u32>) {
-        out.clear();
-        for &o in &self.always {
-            if holds(s, &task.operators[o as usize].pre) {
-                out.push(o);
-            }
-        }
-        for (w, &word) in s.iter().enumerate() {
-            let mut bits = word;
-            while bits != 0 {
-                let f = w * 64 + bits.trailing_zeros() as usize;
-                bits &= bits - 1;
-                if let Some(ops) = self.by_fact.get(f) {
-                    for &o in ops {
-                        if holds(s, &task.operators[o as usize].pre) {
-                            out.push(o);
-                        }
-                    }
-                }
-            }
-        }
-    }
-}
-
-/// States stored once in an arena, found by hash.
-pub(crate) struct Registry {
-    words: usize,
-    arena: Vec<u64>,
-    table: HashTable<u32>,
-    hasher: rustc_hash::FxBuildHasher,
-}
-
-impl Registry {
-    pub(crate) fn new(words: usize) -> Registry {
-        Registry {
-            words,
-            arena: Vec::new(),
-            table: HashTable::new(),
-            hasher: rustc_hash::FxBuildHasher,
-        }
-    }
-
-    pub(crate) fn get(&self, id: u32) -> &[u64] {
-        let i = id as usize * self.words;
-        &self.arena[i..i + self.words]
-    }
-
-    fn hash(&self, s: &[u64]) -> u64 {
-        self.hasher.hash_one(s)
-    }
-
-    /// The state's id, and whether it is new.
-    pub(crate) fn insert(&mut self, s: &[u64]) -> (u32, bool) {
-        let h = self.hash(s);
-        let (arena, words) = (&self.arena, self.words);
-        let at = |id: u32| &arena[id as usize * words..(id as usize + 1) * words];
-        if let Some(&id) = self.table.find(h, |&id| at(id) == s) {
-            return (id, false);
-        }
-        let id = (self.arena.len() / self.words) as u32;
-        self.arena.extend_from_slice(s);
-        let (arena, hasher) = (&self.arena, &self.hasher);
-        self.table.insert_unique(h, id, |&id| {
-            hasher.hash_one(&arena[id as usize * words..(id as usize + 1) * words])
-        });
-        (id, true)
-    }
-}
+use std::time::Instant;
 
 struct Node {
     parent: u32,
@@ -429,34 +263,6 @@ impl<'t> Search<'t> {
 mod tests {
     use super::*;
     use crate::test_util::rooms;
-
-    #[test]
-    fn the_registry_stores_each_state_once() {
-        let mut r = Registry::new(2);
-        assert_eq!(r.insert(&[1, 2]), (0, true));
-        assert_eq!(r.insert(&[3, 4]), (1, true));
-        assert_eq!(r.insert(&[1, 2]), (0, false));
-        assert_eq!(r.get(1), &[3, 4]);
-    }
-
-    #[test]
-    fn successors_are_the_applicable_operators() {
-        let t = rooms();
-        let succ = Successors::new(&t);
-        let mut ax = AxiomScratch::default();
-        let (mut s, mut next, mut app) = (t.init.clone(), Vec::new(), Vec::new());
-        for _ in 0..3 {
-            succ.applicable(&t, &s, &mut app);
-            app.sort_unstable();
-            let scan: Vec<u32> = (0..t.operators.len() as u32)
-                .filter(|&o| holds(&s, &t.operators[o as usize].pre))
-                .collect();
-            assert_eq!(app, scan);
-            let Some(&o) = app.first() else { break };
-            t.apply(&t.operators[o as usize], &s, &mut next, &mut ax);
-            std::mem::swap(&mut s, &mut next);
-        }
-    }
 
     #[test]
     fn astar_finds_the_cheapest_plan() {

@@ -9,6 +9,7 @@ pub mod fit;
 pub mod job;
 pub mod load;
 pub mod loader;
+pub mod misfit;
 pub mod nearby;
 pub mod refs;
 pub mod report;

@@ -4,7 +4,7 @@
 //! are fewer), found by binary search in the names sorted forwards and
 //! backwards. Checking a file of one rule per action is then linear.
 
-use super::ast::NamePart;
+use super::ast::{NamePart, Pattern};
 use super::matching::{count_comparison, match_name, Captures};
 use btc_pddl::ast::{Domain, SmolStr};
 use rustc_hash::FxHashMap;
@@ -85,6 +85,20 @@ fn starting_with<'a>(sorted: &'a [(SmolStr, usize)], prefix: &str) -> &'a [(Smol
     let from = sorted.partition_point(|(n, _)| n.as_str() < prefix);
     let len = sorted[from..].partition_point(|(n, _)| n.starts_with(prefix));
     &sorted[from..from + len]
+}
+
+/// The domain actions a rule pattern's name matches, with their captures
+/// (in domain order).
+pub fn matched_actions<'d>(
+    pattern: &Pattern,
+    domain: &'d Domain,
+    actions: &ActionIndex,
+) -> Vec<(&'d btc_pddl::ast::Action, Captures)> {
+    actions
+        .matches(&pattern.name, domain)
+        .into_iter()
+        .map(|(i, c)| (&domain.actions[i], c))
+        .collect()
 }
 
 #[cfg(test)]

@@ -452,6 +452,37 @@ impl Template {
             | Template::Error { span } => *span,
         }
     }
+
+    /// The templates right inside this one: a control's block, the
+    /// template a decorator decorates.
+    pub fn children(&self) -> &[Template] {
+        match self {
+            Template::Control { children, .. } => children,
+            Template::Decorator { child, .. } => std::slice::from_ref(&**child),
+            Template::Call { .. }
+            | Template::Script { .. }
+            | Template::Steps { .. }
+            | Template::Error { .. } => &[],
+        }
+    }
+
+    /// Calls `f` on this template and every template inside it, each
+    /// before the ones inside it. The one walk over templates: the passes
+    /// that only look at each template use it (the parser bounds the
+    /// nesting, `parse::MAX_ITEM_DEPTH`).
+    pub fn walk<'t>(&'t self, f: &mut dyn FnMut(&'t Template)) {
+        f(self);
+        for c in self.children() {
+            c.walk(f);
+        }
+    }
+
+    /// [`Template::walk`] over each template of a body, in order.
+    pub fn walk_all<'t>(body: &'t [Template], f: &mut dyn FnMut(&'t Template)) {
+        for t in body {
+            t.walk(f);
+        }
+    }
 }
 
 /// One per top-level item: boxing the large variants would buy nothing.

@@ -10,7 +10,7 @@
 //! with no name matching of its own.
 
 use super::ast::*;
-use super::check::{Decls, DomainCtx};
+use super::decls::{Decls, DomainCtx};
 use super::reach::{matches_every_step, reach, Verdict};
 use btc_pddl::ast::Domain;
 use btc_pddl::diagnostic::{closest, codes, Diagnostic};
@@ -78,19 +78,15 @@ pub fn uses(item: &Item) -> ItemUses {
         }
     }
     fn template(t: &Template, out: &mut ItemUses) {
-        match t {
-            Template::Control { children, .. } => children.iter().for_each(|c| template(c, out)),
-            Template::Decorator { args, child, .. } => {
-                args.iter().for_each(|a| value(&a.value, out));
-                template(child, out);
-            }
+        t.walk(&mut |t| match t {
+            Template::Decorator { args, .. } => args.iter().for_each(|a| value(&a.value, out)),
             Template::Call { name, args, .. } => {
                 out.names.insert(name.text.clone());
                 args.iter().for_each(|a| value(&a.value, out));
             }
             Template::Error { .. } => out.broken = true,
-            Template::Steps { .. } | Template::Script { .. } => {}
-        }
+            Template::Control { .. } | Template::Steps { .. } | Template::Script { .. } => {}
+        });
     }
     let mut out = ItemUses::default();
     match item {

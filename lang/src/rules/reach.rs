@@ -6,7 +6,7 @@
 //! covers nothing (R012).
 
 use super::ast::{Guard, Operand, Rule};
-use super::check::{Decls, DomainCtx};
+use super::decls::{Decls, DomainCtx};
 use super::matching::{bind_params, Captures};
 use super::name::Key;
 use btc_pddl::ast::Action;

@@ -348,29 +348,24 @@ impl Walk<'_> {
     }
 
     fn templates(&mut self, ts: &[Template]) {
-        for t in ts {
-            self.template(t);
-        }
+        Template::walk_all(ts, &mut |t| self.template(t));
     }
 
+    /// One template's own names (the walk goes inside it).
     fn template(&mut self, t: &Template) {
         match t {
-            Template::Control { name, children, .. } => {
+            Template::Control { name, .. } => {
                 if let Some(n) = name {
                     self.string(n);
                 }
-                self.templates(children);
             }
-            Template::Decorator {
-                args, name, child, ..
-            } => {
+            Template::Decorator { args, name, .. } => {
                 for a in args {
                     self.value(&a.value);
                 }
                 if let Some(n) = name {
                     self.string(n);
                 }
-                self.template(child);
             }
             Template::Call { name, args, .. } => {
                 let ports = self.decls.ports(&name.text);

@@ -3,7 +3,7 @@
 //! while they evaluate their body.
 
 use super::compile::{CTerm, Cond, Eff, Num, Quant};
-use super::{Changes, NumericError, State, World};
+use super::{Changes, Key, NumericError, State, World};
 use crate::ast::{AssignOp, Comparison, NumOp};
 
 /// Atoms of more arguments are keyed through the heap.
@@ -40,7 +40,11 @@ impl World {
 
     /// Calls `f` with `b` extended by each binding of `q`; stops (and
     /// returns true) when `f` returns true.
-    fn any_binding(q: &Quant, b: &mut Vec<u32>, f: &mut dyn FnMut(&mut Vec<u32>) -> bool) -> bool {
+    pub(crate) fn any_binding(
+        q: &Quant,
+        b: &mut Vec<u32>,
+        f: &mut dyn FnMut(&mut Vec<u32>) -> bool,
+    ) -> bool {
         fn go(
             ranges: &[std::sync::Arc<[u32]>],
             b: &mut Vec<u32>,
@@ -258,23 +262,45 @@ impl World {
         duration: Option<f64>,
         changes: &mut Changes,
     ) {
+        let mut collect = Collect {
+            world: self,
+            s,
+            duration,
+            changes,
+        };
+        self.walk_effect(s, e, b, duration, &mut collect);
+    }
+
+    /// Walks the parts of effect `e` that apply in `s` under binding `b`:
+    /// each atom it adds or deletes and each fluent it assigns, through
+    /// `and`, every binding of a `forall`, and the `when`s whose condition
+    /// holds (every `when`'s condition is shown to `v` first).
+    pub fn walk_effect(
+        &self,
+        s: &State,
+        e: &Eff,
+        b: &mut Vec<u32>,
+        duration: Option<f64>,
+        v: &mut dyn EffectVisitor,
+    ) {
         match e {
-            Eff::Add { pred, args } => changes.add.push(Self::key(*pred, args, b)),
-            Eff::Del { pred, args } => changes.delete.push(Self::key(*pred, args, b)),
+            Eff::Add { pred, args } => v.atom(true, Self::key(*pred, args, b)),
+            Eff::Del { pred, args } => v.atom(false, Self::key(*pred, args, b)),
             Eff::And(ps) => {
                 for p in ps {
-                    self.collect(s, p, b, duration, changes);
+                    self.walk_effect(s, p, b, duration, v);
                 }
             }
             Eff::Forall(q, body) => {
                 Self::any_binding(q, b, &mut |b| {
-                    self.collect(s, body, b, duration, changes);
+                    self.walk_effect(s, body, b, duration, v);
                     false
                 });
             }
             Eff::When(c, body) => {
+                v.condition(c, b);
                 if self.holds(s, c, b, duration) {
-                    self.collect(s, body, b, duration, changes);
+                    self.walk_effect(s, body, b, duration, v);
                 }
             }
             Eff::Numeric {
@@ -282,25 +308,7 @@ impl World {
                 func,
                 args,
                 value,
-            } => {
-                let key = Self::key(*func, args, b);
-                let old = s.fluents.get(&key).copied();
-                let v = self.value(s, value, b, duration);
-                let new = match (op, old, v) {
-                    (AssignOp::Assign, _, Some(v)) => Some(v),
-                    (AssignOp::Increase, Some(o), Some(v)) => Some(o + v),
-                    (AssignOp::Decrease, Some(o), Some(v)) => Some(o - v),
-                    (AssignOp::ScaleUp, Some(o), Some(v)) => Some(o * v),
-                    (AssignOp::ScaleDown, Some(o), Some(v)) => Some(o / v),
-                    _ => None,
-                };
-                match new {
-                    Some(n) => changes.numeric.push((key, n)),
-                    None => changes.numeric_errors.push(NumericError {
-                        fluent: self.show_fluent(&key),
-                    }),
-                }
-            }
+            } => v.numeric(*op, Self::key(*func, args, b), value, b),
         }
     }
 
@@ -333,6 +341,55 @@ impl World {
                 }
                 s.derived.extend(found);
             }
+        }
+    }
+}
+
+/// What an effect does, part by part, as [`World::walk_effect`] meets the
+/// parts: applying it ([`World::collect`]) and finding what it touches
+/// (the interference of timed plans) are two visitors.
+pub trait EffectVisitor {
+    /// An atom added (`positive`) or deleted.
+    fn atom(&mut self, positive: bool, atom: Key);
+    /// A fluent assigned or updated by `op` with `value` under binding `b`.
+    fn numeric(&mut self, op: AssignOp, fluent: Key, value: &Num, b: &mut Vec<u32>);
+    /// A `when`'s condition, before it is evaluated.
+    fn condition(&mut self, _c: &Cond, _b: &mut Vec<u32>) {}
+}
+
+/// The changes of an effect in a state, collected as they are met.
+struct Collect<'a> {
+    world: &'a World,
+    s: &'a State,
+    duration: Option<f64>,
+    changes: &'a mut Changes,
+}
+
+impl EffectVisitor for Collect<'_> {
+    fn atom(&mut self, positive: bool, atom: Key) {
+        if positive {
+            self.changes.add.push(atom);
+        } else {
+            self.changes.delete.push(atom);
+        }
+    }
+
+    fn numeric(&mut self, op: AssignOp, key: Key, value: &Num, b: &mut Vec<u32>) {
+        let old = self.s.fluents.get(&key).copied();
+        let v = self.world.value(self.s, value, b, self.duration);
+        let new = match (op, old, v) {
+            (AssignOp::Assign, _, Some(v)) => Some(v),
+            (AssignOp::Increase, Some(o), Some(v)) => Some(o + v),
+            (AssignOp::Decrease, Some(o), Some(v)) => Some(o - v),
+            (AssignOp::ScaleUp, Some(o), Some(v)) => Some(o * v),
+            (AssignOp::ScaleDown, Some(o), Some(v)) => Some(o / v),
+            _ => None,
+        };
+        match new {
+            Some(n) => self.changes.numeric.push((key, n)),
+            None => self.changes.numeric_errors.push(NumericError {
+                fluent: self.world.show_fluent(&key),
+            }),
         }
     }
 }

@@ -18,6 +18,7 @@ mod compile;
 mod eval;
 
 pub use compile::{CTerm, CompiledAction, Cond, Eff, Num, Quant};
+pub use eval::EffectVisitor;
 
 /// A ground atom or fluent: `[predicate or function index, object ids...]`.
 pub type Key = Box<[u32]>;

@@ -10,7 +10,7 @@
 //! the same atom, or both increasing or decreasing the same fluent, do not.
 
 use crate::ast::AssignOp;
-use crate::state::{CTerm, Cond, Eff, Key, Num, State, World};
+use crate::state::{CTerm, Cond, Eff, EffectVisitor, Key, Num, State, World};
 use rustc_hash::FxHashSet;
 
 /// The atoms and fluents an event touches.
@@ -49,7 +49,7 @@ impl Footprint {
             f.read_cond(c, b);
         }
         for e in effects {
-            f.effect(world, s, e, b, duration);
+            world.walk_effect(s, e, b, duration, &mut f);
         }
         f
     }
@@ -67,7 +67,10 @@ impl Footprint {
                 self.read_cond(r, b);
             }
             Cond::Exists(q, body) | Cond::Forall(q, body) => {
-                each_binding(&q.ranges, b, &mut |b| self.read_cond(body, b))
+                World::any_binding(q, b, &mut |b| {
+                    self.read_cond(body, b);
+                    false
+                });
             }
             Cond::Compare(_, l, r) => {
                 self.read_num(l, b);
@@ -87,46 +90,6 @@ impl Footprint {
             }
             Num::Neg(x) => self.read_num(x, b),
             Num::Const(_) | Num::Undefined | Num::Duration => {}
-        }
-    }
-
-    fn effect(
-        &mut self,
-        world: &World,
-        s: &State,
-        e: &Eff,
-        b: &mut Vec<u32>,
-        duration: Option<f64>,
-    ) {
-        match e {
-            Eff::Add { pred, args } => {
-                self.adds.insert(key(*pred, args, b));
-            }
-            Eff::Del { pred, args } => {
-                self.deletes.insert(key(*pred, args, b));
-            }
-            Eff::And(es) => es
-                .iter()
-                .for_each(|e| self.effect(world, s, e, b, duration)),
-            Eff::Forall(q, body) => each_binding(&q.ranges, b, &mut |b| {
-                self.effect(world, s, body, b, duration)
-            }),
-            Eff::When(c, body) => {
-                self.read_cond(c, b);
-                if world.holds(s, c, b, duration) {
-                    self.effect(world, s, body, b, duration);
-                }
-            }
-            Eff::Numeric {
-                op,
-                func,
-                args,
-                value,
-            } => {
-                self.read_num(value, b);
-                let additive = matches!(op, AssignOp::Increase | AssignOp::Decrease);
-                self.updates.push((key(*func, args, b), additive));
-            }
         }
     }
 
@@ -215,6 +178,28 @@ impl Footprint {
     }
 }
 
+/// A `when` counts as read whether or not it holds; its effect as
+/// written only when it does, as VAL has it.
+impl EffectVisitor for Footprint {
+    fn atom(&mut self, positive: bool, atom: Key) {
+        if positive {
+            self.adds.insert(atom);
+        } else {
+            self.deletes.insert(atom);
+        }
+    }
+
+    fn numeric(&mut self, op: AssignOp, fluent: Key, value: &Num, b: &mut Vec<u32>) {
+        self.read_num(value, b);
+        let additive = matches!(op, AssignOp::Increase | AssignOp::Decrease);
+        self.updates.push((fluent, additive));
+    }
+
+    fn condition(&mut self, c: &Cond, b: &mut Vec<u32>) {
+        self.read_cond(c, b);
+    }
+}
+
 fn key(head: u32, args: &[CTerm], b: &[u32]) -> Key {
     std::iter::once(head)
         .chain(args.iter().map(|a| match *a {
@@ -222,21 +207,4 @@ fn key(head: u32, args: &[CTerm], b: &[u32]) -> Key {
             CTerm::Obj(o) => o,
         }))
         .collect()
-}
-
-/// Calls `f` with `b` extended by each binding of the quantified
-/// variables ranging over `ranges`.
-fn each_binding(
-    ranges: &[std::sync::Arc<[u32]>],
-    b: &mut Vec<u32>,
-    f: &mut dyn FnMut(&mut Vec<u32>),
-) {
-    let Some((first, rest)) = ranges.split_first() else {
-        return f(b);
-    };
-    for &o in first.iter() {
-        b.push(o);
-        each_binding(rest, b, f);
-        b.pop();
-    }
 }

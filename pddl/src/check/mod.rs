@@ -1,7 +1,13 @@
 //! Semantic checks of domains and problems, and the symbol tables that every
 //! later stage (plan typing, validation, rule checking) looks names up in.
 
+mod derived;
 mod inferred;
+mod requirements;
+
+use derived::stratify;
+pub use derived::{collect_derived_uses, strata_of};
+use requirements::{requirements, undeclared_requirements, Feature};
 
 use super::ast::*;
 use super::types::{TypeId, TypeTable};
@@ -60,161 +66,6 @@ impl ProblemIndex {
         (0..self.object_names.len() as u32)
             .filter(|&i| types.fits(&self.object_types[i as usize], want))
             .collect()
-    }
-}
-
-const KNOWN_REQUIREMENTS: &[&str] = &[
-    "strips",
-    "typing",
-    "negative-preconditions",
-    "disjunctive-preconditions",
-    "equality",
-    "existential-preconditions",
-    "universal-preconditions",
-    "quantified-preconditions",
-    "conditional-effects",
-    "fluents",
-    "numeric-fluents",
-    "object-fluents",
-    "adl",
-    "durative-actions",
-    "duration-inequalities",
-    "continuous-effects",
-    "derived-predicates",
-    "timed-initial-literals",
-    "preferences",
-    "constraints",
-    "action-costs",
-    "domain-axioms",
-    "safety-constraints",
-    "expression-evaluation",
-    "open-world",
-    "true-negation",
-    "ucpop",
-    "foreach-expansions",
-    "dag-expansions",
-    "subgoal-through-axioms",
-];
-
-const UNSUPPORTED_REQUIREMENTS: &[&str] = &[
-    "object-fluents",
-    "duration-inequalities",
-    "continuous-effects",
-    "timed-initial-literals",
-    "preferences",
-    "constraints",
-    "domain-axioms",
-    "safety-constraints",
-    "open-world",
-    "true-negation",
-    "foreach-expansions",
-    "dag-expansions",
-    "subgoal-through-axioms",
-    "expression-evaluation",
-];
-
-fn expand_requirement(r: &str, out: &mut FxHashSet<String>) {
-    out.insert(r.to_owned());
-    let implied: &[&str] = match r {
-        "adl" | "ucpop" => &[
-            "strips",
-            "typing",
-            "disjunctive-preconditions",
-            "equality",
-            "quantified-preconditions",
-            "conditional-effects",
-        ],
-        "quantified-preconditions" => &["existential-preconditions", "universal-preconditions"],
-        "fluents" => &["numeric-fluents"],
-        "timed-initial-literals" => &["durative-actions"],
-        _ => &[],
-    };
-    for i in implied {
-        expand_requirement(i, out);
-    }
-}
-
-/// Reads `:requirements` into a set, reporting unknown and unsupported flags.
-fn requirements(reqs: &[Name], diags: &mut Vec<Diagnostic>) -> FxHashSet<String> {
-    let mut set = FxHashSet::default();
-    for r in reqs {
-        if !KNOWN_REQUIREMENTS.contains(&r.as_str()) {
-            let d = Diagnostic::error(
-                codes::UNKNOWN_REQUIREMENT,
-                r.span,
-                format!("`:{}` is not a PDDL requirement", r.name),
-            );
-            diags.push(
-                match did_you_mean(&r.name, KNOWN_REQUIREMENTS.iter().copied()) {
-                    Some(h) => d.with_hint(h),
-                    None => d,
-                },
-            );
-            continue;
-        }
-        if UNSUPPORTED_REQUIREMENTS.contains(&r.as_str()) {
-            diags.push(
-                Diagnostic::error(
-                    codes::UNSUPPORTED,
-                    r.span,
-                    format!("the requirement `:{}` is not supported by btc", r.name),
-                )
-                .with_hint("btc supports STRIPS, typing, ADL conditions and effects, derived predicates, numeric fluents, action costs and durative actions"),
-            );
-        }
-        expand_requirement(&r.name, &mut set);
-    }
-    if reqs.is_empty() {
-        set.insert("strips".into());
-    }
-    set
-}
-
-/// A feature a file uses, for "used but not declared" warnings.
-#[derive(Clone, Copy, PartialEq, Eq, Hash, Debug)]
-enum Feature {
-    Typing,
-    Negation,
-    Disjunction,
-    Equality,
-    Existential,
-    Universal,
-    ConditionalEffects,
-    Numeric,
-    Durative,
-    Derived,
-}
-
-impl Feature {
-    /// The requirement flags that allow this feature (any one of them).
-    fn allowed_by(self) -> &'static [&'static str] {
-        match self {
-            Feature::Typing => &["typing"],
-            Feature::Negation => &["negative-preconditions", "disjunctive-preconditions"],
-            Feature::Disjunction => &["disjunctive-preconditions"],
-            Feature::Equality => &["equality"],
-            Feature::Existential => &["existential-preconditions"],
-            Feature::Universal => &["universal-preconditions"],
-            Feature::ConditionalEffects => &["conditional-effects"],
-            Feature::Numeric => &["numeric-fluents", "action-costs"],
-            Feature::Durative => &["durative-actions"],
-            Feature::Derived => &["derived-predicates"],
-        }
-    }
-
-    fn describe(self) -> &'static str {
-        match self {
-            Feature::Typing => "typed names",
-            Feature::Negation => "a negative condition (`not`)",
-            Feature::Disjunction => "a disjunctive condition (`or` / `imply`)",
-            Feature::Equality => "an equality test (`=`)",
-            Feature::Existential => "an `exists` condition",
-            Feature::Universal => "a `forall` condition",
-            Feature::ConditionalEffects => "a conditional or quantified effect (`when` / `forall`)",
-            Feature::Numeric => "numeric functions",
-            Feature::Durative => "a durative action",
-            Feature::Derived => "a derived predicate",
-        }
     }
 }
 
@@ -602,30 +453,6 @@ fn render_decl(p: &PredicateDecl) -> String {
     s
 }
 
-fn undeclared_requirements(
-    used: &FxHashMap<Feature, Span>,
-    declared: &FxHashSet<String>,
-) -> Vec<Diagnostic> {
-    let mut out: Vec<Diagnostic> = used
-        .iter()
-        .filter(|(f, _)| !f.allowed_by().iter().any(|r| declared.contains(*r)))
-        .map(|(f, span)| {
-            let flag = f.allowed_by()[0];
-            Diagnostic::warning(
-                codes::UNDECLARED_REQUIREMENT,
-                *span,
-                format!(
-                    "{} needs the requirement `:{flag}`, which is not declared",
-                    f.describe()
-                ),
-            )
-            .with_hint(format!("add `:{flag}` to `(:requirements ...)`"))
-        })
-        .collect();
-    out.sort_by_key(|d| d.span.start);
-    out
-}
-
 impl Checker<'_> {
     fn use_feature(&mut self, f: Feature, span: Span) {
         self.used.entry(f).or_insert(span);
@@ -936,124 +763,5 @@ impl Checker<'_> {
                 self.num_expr(value, scope);
             }
         }
-    }
-}
-
-/// Orders derived predicates into strata (stratified negation), reporting
-/// predicates that depend negatively on themselves.
-fn stratify(domain: &Domain, index: &DomainIndex, diags: &mut Vec<Diagnostic>) -> Vec<Vec<usize>> {
-    let n = domain.derived.len();
-    if n == 0 {
-        return Vec::new();
-    }
-    // uses[i]: (j, negative) — rule i's body mentions the predicate rule j derives.
-    let uses: Vec<Vec<(usize, bool)>> = domain
-        .derived
-        .iter()
-        .map(|d| {
-            let mut out = Vec::new();
-            collect_derived_uses(&d.body, true, &mut |name, positive| {
-                if index.derived.contains(name) {
-                    for (j, other) in domain.derived.iter().enumerate() {
-                        if other.head.name.name == name {
-                            out.push((j, !positive));
-                        }
-                    }
-                }
-            });
-            out
-        })
-        .collect();
-    match strata_of(&uses) {
-        Some(strata) => strata,
-        None => {
-            let d = &domain.derived[0];
-            diags.push(
-                Diagnostic::error(
-                    codes::NOT_STRATIFIED,
-                    d.head.name.span,
-                    "derived predicates depend on their own negation",
-                )
-                .with_hint(
-                    "rewrite the `:derived` rules so no predicate depends on its own negation",
-                ),
-            );
-            vec![(0..n).collect()]
-        }
-    }
-}
-
-/// Strata of derived rules from what each rule's body uses (`uses[i]`:
-/// rules `j` it depends on, and whether through a negation): a rule comes
-/// no earlier than what it uses, and after what it negates. `None` when a
-/// rule depends on its own negation.
-pub fn strata_of(uses: &[Vec<(usize, bool)>]) -> Option<Vec<Vec<usize>>> {
-    let n = uses.len();
-    let mut level = vec![0usize; n];
-    // Bellman-Ford style relaxation; a level above n means a negative cycle.
-    for _ in 0..=n {
-        let mut changed = false;
-        for i in 0..n {
-            for &(j, neg) in &uses[i] {
-                let need = level[j] + usize::from(neg);
-                if level[i] < need {
-                    level[i] = need;
-                    changed = true;
-                }
-            }
-        }
-        if !changed {
-            break;
-        }
-    }
-    if level.iter().any(|&l| l > n) || has_negative_cycle(uses, n) {
-        return None;
-    }
-    let max = level.iter().copied().max().unwrap_or(0);
-    // Several rules may derive the same predicate: they share a level.
-    Some(
-        (0..=max)
-            .map(|l| (0..n).filter(|&i| level[i] == l).collect())
-            .filter(|v: &Vec<usize>| !v.is_empty())
-            .collect(),
-    )
-}
-
-fn has_negative_cycle(edges: &[Vec<(usize, bool)>], n: usize) -> bool {
-    // A negative edge i -> j where j reaches i makes the program unstratifiable.
-    let reach = |from: usize, to: usize| {
-        let mut seen = vec![false; n];
-        let mut stack = vec![from];
-        while let Some(x) = stack.pop() {
-            if x == to {
-                return true;
-            }
-            if !std::mem::replace(&mut seen[x], true) {
-                stack.extend(edges[x].iter().map(|e| e.0));
-            }
-        }
-        false
-    };
-    (0..n).any(|i| edges[i].iter().any(|&(j, neg)| neg && reach(j, i)))
-}
-
-/// Calls `f(predicate, positive)` for each atom in a formula.
-pub fn collect_derived_uses(f: &Formula, positive: bool, out: &mut impl FnMut(&str, bool)) {
-    match f {
-        Formula::Atom { atom } => out(atom.pred.as_str(), positive),
-        Formula::Not { formula, .. } => collect_derived_uses(formula, !positive, out),
-        Formula::And { parts, .. } | Formula::Or { parts, .. } => {
-            for p in parts {
-                collect_derived_uses(p, positive, out);
-            }
-        }
-        Formula::Imply { left, right, .. } => {
-            collect_derived_uses(left, !positive, out);
-            collect_derived_uses(right, positive, out);
-        }
-        Formula::Exists { body, .. } | Formula::Forall { body, .. } => {
-            collect_derived_uses(body, positive, out)
-        }
-        Formula::Equal { .. } | Formula::Compare { .. } => {}
     }
 }
