@@ -464,3 +464,162 @@ impl<'w> TaskManager<'w> {
         )
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::random::{self, Scenario};
+
+    fn attempt(outcome: &str) -> Attempt {
+        Attempt {
+            agent: "floor_robot".into(),
+            start_tick: 1,
+            end_tick: 2,
+            part: None,
+            goal: String::new(),
+            plan: Vec::new(),
+            planning_ms: 0.0,
+            outcome: outcome.into(),
+            challenges: Vec::new(),
+        }
+    }
+
+    fn announced(ty: OrderType) -> (Trial, Trace) {
+        let trial = random::experiment(ty, Scenario::Normal, 1);
+        (trial, Trace::new(true))
+    }
+
+    #[test]
+    fn a_kitting_order_is_a_tray_task_and_kit_tasks_after_it() {
+        let (trial, mut trace) = announced(OrderType::Kitting);
+        let mut tm = TaskManager::new(&trial);
+        tm.announce(0, 1, &mut trace);
+        let n = tm.tasks.len();
+        assert!(n > 1);
+        assert!(matches!(tm.tasks[0].work, Work::Tray { .. }));
+        assert_eq!(tm.tasks[0].state, TaskState::Queued);
+        for t in &tm.tasks[1..] {
+            assert!(matches!(t.work, Work::Kit { .. }));
+            assert_eq!(
+                (t.state.clone(), t.after.clone()),
+                (TaskState::Blocked, vec![0])
+            );
+        }
+        tm.unblock();
+        assert_eq!(tm.tasks[1].state, TaskState::Blocked, "the tray is open");
+        tm.done(0, attempt("done"), 3, &mut trace);
+        tm.unblock();
+        assert!(tm.tasks[1..].iter().all(|t| t.state == TaskState::Queued));
+        assert_eq!(tm.queued(OrderType::Kitting, false).count(), n - 1);
+        assert_eq!(tm.orders[0].announced, Some(1));
+        assert!(trace.finish().contains("\"what\":\"announced\""));
+    }
+
+    #[test]
+    fn split_makes_a_kitting_half_and_an_assembly_half_that_waits_for_it() {
+        let (trial, mut trace) = announced(OrderType::Combined);
+        let mut tm = TaskManager::new(&trial);
+        tm.announce(0, 1, &mut trace);
+        assert!(matches!(tm.tasks[0].work, Work::Combined { .. }));
+        tm.split(0, 2, 3, 4, &mut trace);
+        assert_eq!(tm.tasks[0].state, TaskState::Split { into: vec![4, 5] });
+        let kit = tm.tasks.len() - 2;
+        assert_eq!(kit, 4);
+        assert!(matches!(
+            tm.tasks[kit].work,
+            Work::Kit {
+                agv: 2,
+                quadrant: 3,
+                ..
+            }
+        ));
+        assert_eq!(tm.tasks[kit].queue, OrderType::Kitting);
+        let asm = &tm.tasks[kit + 1];
+        assert!(
+            matches!(&asm.work, Work::Assemble { from_task: Some(k), agvs, .. } if *k == kit && *agvs == [2])
+        );
+        assert_eq!(
+            (asm.state.clone(), asm.after.clone()),
+            (TaskState::Blocked, vec![kit])
+        );
+        assert_eq!(tm.orders[0].agv, Some(2));
+        // The assembly half waits for the kitting half and the quality check.
+        tm.done(kit, attempt("done"), 5, &mut trace);
+        tm.unblock();
+        assert_eq!(tm.tasks[kit + 1].state, TaskState::Blocked);
+        tm.orders[0].qc_done = true;
+        tm.unblock();
+        assert_eq!(tm.tasks[kit + 1].state, TaskState::Queued);
+    }
+
+    #[test]
+    fn convert_makes_one_assembly_task_from_the_bins() {
+        let (trial, mut trace) = announced(OrderType::Combined);
+        let mut tm = TaskManager::new(&trial);
+        tm.announce(0, 1, &mut trace);
+        let asm = tm.convert(1, 2, &mut trace).unwrap();
+        assert_eq!(tm.tasks[1].state, TaskState::Split { into: vec![asm] });
+        assert!(
+            matches!(&tm.tasks[asm].work, Work::Assemble { from_task: None, agvs, .. } if agvs.is_empty())
+        );
+        assert_eq!(tm.tasks[asm].state, TaskState::Queued);
+        assert_eq!(tm.convert(asm, 2, &mut trace), None, "only a combined task");
+        assert!(trace.finish().contains("\"what\":\"converted\""));
+    }
+
+    #[test]
+    fn a_failed_attempt_is_requeued_until_the_last_then_given_up() {
+        let (trial, mut trace) = announced(OrderType::Assembly);
+        let mut tm = TaskManager::new(&trial);
+        tm.announce(0, 1, &mut trace);
+        let why = || "`pick` failed: dropped".to_owned();
+        assert_eq!(
+            tm.attempt_failed(0, attempt("failed"), why(), 2, 3, &mut trace),
+            None
+        );
+        assert_eq!(
+            (tm.tasks[0].state.clone(), tm.tasks[0].reassignments),
+            (TaskState::Queued, 1)
+        );
+        let cause = tm
+            .attempt_failed(0, attempt("failed"), why(), 2, 4, &mut trace)
+            .unwrap();
+        assert_eq!(
+            cause.to_string(),
+            "gave up after 2 attempts; the last: `pick` failed: dropped"
+        );
+        tm.fail(0, &cause, 4, &mut trace);
+        assert!(
+            matches!(&tm.tasks[0].state, TaskState::Failed { tick: 4, cause: c } if *c == cause.to_string())
+        );
+        assert!(!tm.order_ended(0), "the other parts are still open");
+        tm.preempted(1, attempt("preempted"), "o2".into(), 5, &mut trace);
+        assert_eq!(
+            (tm.tasks[1].state.clone(), tm.tasks[1].reassignments),
+            (TaskState::Queued, 1)
+        );
+    }
+
+    #[test]
+    fn when_a_kitting_half_fails_its_assembly_half_takes_a_part_from_the_bins() {
+        let (trial, mut trace) = announced(OrderType::Combined);
+        let mut tm = TaskManager::new(&trial);
+        tm.announce(0, 1, &mut trace);
+        tm.split(0, 1, 1, 2, &mut trace);
+        let (kit, asm) = (tm.tasks.len() - 2, tm.tasks.len() - 1);
+        let cause = Cause::InsufficientParts {
+            part: crate::trial::PartKind {
+                ty: crate::trial::PartType::Pump,
+                color: crate::trial::Color::Red,
+            },
+            from_agvs: Vec::new(),
+        };
+        assert!(cause.insufficient());
+        tm.fail(kit, &cause, 3, &mut trace);
+        assert!(
+            matches!(&tm.tasks[asm].work, Work::Assemble { from_task: None, agvs, .. } if agvs.is_empty())
+        );
+        tm.unblock();
+        assert_eq!(tm.tasks[asm].state, TaskState::Queued);
+    }
+}
