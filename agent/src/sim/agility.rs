@@ -9,6 +9,7 @@ use super::model::Sim;
 use super::world::PartId;
 use crate::cell::Var;
 use crate::trial::{Condition, Robot, Task as OrderTask};
+use btc_pddl::state::Key;
 use btc_runtime::faults::{FaultKind, FaultSpec};
 use btc_runtime::Scenario;
 
@@ -320,6 +321,51 @@ impl Sim<'_, '_> {
             c.note(format!(
                 "{name} lies flipped: the plan of task {t} turns it over"
             ));
+        }
+    }
+
+    /// The parts the agents' tick placed on AGVs (faulty parts) and picked
+    /// (the faulty gripper's drops).
+    pub(super) fn placements_and_picks(&mut self) {
+        // Placements on AGVs.
+        let kit = self.w.facts_of(&self.w.facts.in_kit);
+        let new_kit: Vec<Key> = kit.difference(&self.prev_kit).cloned().collect();
+        self.prev_kit = kit;
+        for k in new_kit {
+            let (Some(p), Some(agv), Some(q)) = (
+                self.w.facts.in_kit.get(&k, Var::Part),
+                self.w.facts.in_kit.get(&k, Var::Agv),
+                self.w.facts.in_kit.get(&k, Var::Quadrant),
+            ) else {
+                continue;
+            };
+            let (Some(&part), Some(n), Some(qn)) = (
+                self.w.part_of.get(&p),
+                self.w.obj.agv.iter().position(|&x| x == agv),
+                self.w.obj.quadrant.iter().position(|&x| x == q),
+            ) else {
+                continue;
+            };
+            self.placed.push((part, n as u8 + 1));
+            self.faulty_on_place(part, n as u8 + 1, qn as u8 + 1);
+        }
+        // Picks.
+        let holding = self.w.facts_of(&self.w.facts.holding);
+        let picks: Vec<Key> = holding.difference(&self.prev_holding).cloned().collect();
+        self.prev_holding = holding;
+        for k in picks {
+            let (Some(r), Some(p)) = (
+                self.w.facts.holding.get(&k, Var::Robot),
+                self.w.facts.holding.get(&k, Var::Part),
+            ) else {
+                continue;
+            };
+            if let (Some(a), Some(&part)) = (
+                self.agents.iter().position(|x| x.obj == r),
+                self.w.part_of.get(&p),
+            ) {
+                self.on_pick(a, part);
+            }
         }
     }
 }

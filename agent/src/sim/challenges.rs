@@ -8,7 +8,8 @@
 //! to whom, and the runtime faults it means for a robot's tree.
 
 use crate::cell::spec::Time;
-use crate::trial::{Behavior, ChallengeKind, Condition, PartKind, Robot};
+use crate::cell::{Cell, Origin, PartInfo};
+use crate::trial::{Behavior, ChallengeKind, Condition, PartKind, Robot, Trial};
 use btc_runtime::faults::{Blackout, FaultKind, FaultSpec, Trigger};
 
 /// ARIAC's faulty parts: the first part placed in each flagged quadrant of
@@ -333,6 +334,42 @@ impl Challenge {
             format!("{head}: {what}")
         }
     }
+}
+
+/// The trial's challenges at the start: its own, one per high-priority
+/// order, one per lot of flipped parts.
+pub fn at_start(cell: &Cell, trial: &Trial, parts: &[PartInfo]) -> Vec<Challenge> {
+    let mut out: Vec<Challenge> = Vec::new();
+    for (k, c) in trial.challenges.iter().enumerate() {
+        let kind = Kind::of_trial(&c.kind);
+        out.push(Challenge::new(format!("{}#{}", kind.name(), k + 1), kind));
+    }
+    for (k, o) in trial.orders.iter().enumerate() {
+        if o.priority {
+            out.push(Challenge::new(
+                format!("high_priority_order({})", o.id),
+                Kind::HighPriorityOrder { order: k },
+            ));
+        }
+    }
+    let mut flipped_lots: Vec<(PartKind, String)> = Vec::new();
+    for p in parts.iter().filter(|p| p.flipped) {
+        let place = match p.origin {
+            Origin::Bin { bin, .. } => cell.bin(bin),
+            Origin::Agv { agv, .. } => cell.agv(agv),
+            Origin::Conveyor { .. } => cell.conveyor(),
+        };
+        if !flipped_lots.contains(&(p.kind, place.clone())) {
+            flipped_lots.push((p.kind, place));
+        }
+    }
+    for (kind, place) in flipped_lots {
+        out.push(Challenge::new(
+            format!("flipped_part({kind} in {place})"),
+            Kind::FlippedParts { kind, place },
+        ));
+    }
+    out
 }
 
 /// A runtime fault a challenge injects into a robot's tree from tick `at`.

@@ -11,13 +11,13 @@
 //! (the checking mode), `report`.
 
 use super::agent::AgentRt;
-use super::challenges::{Challenge, Kind};
+use super::challenges::{self, Challenge, Kind};
 use super::events::{Event, Trace};
 use super::options::{TrialError, TrialOptions};
 use super::task_manager::TaskManager;
 use super::world::{id, CellWorld, PartId};
-use crate::cell::{Cell, Origin, TrialProblem};
-use crate::trial::{Condition, PartKind, Robot, Trial};
+use crate::cell::{Cell, TrialProblem};
+use crate::trial::{Condition, Robot, Trial};
 use btc_lang::db::{CompileJob, Database};
 use btc_pddl::pipeline::ProblemUnit;
 use btc_pddl::state::Key;
@@ -49,42 +49,6 @@ pub(super) struct Sim<'w, 'd> {
     /// What the last tick left: stopping needs two quiet ticks alike.
     pub last: (usize, usize, usize, usize),
     pub stopped: String,
-}
-
-/// The trial's challenges at the start: its own, one per high-priority
-/// order, one per lot of flipped parts.
-fn challenges(cell: &Cell, trial: &Trial, tp: &TrialProblem) -> Vec<Challenge> {
-    let mut out: Vec<Challenge> = Vec::new();
-    for (k, c) in trial.challenges.iter().enumerate() {
-        let kind = Kind::of_trial(&c.kind);
-        out.push(Challenge::new(format!("{}#{}", kind.name(), k + 1), kind));
-    }
-    for (k, o) in trial.orders.iter().enumerate() {
-        if o.priority {
-            out.push(Challenge::new(
-                format!("high_priority_order({})", o.id),
-                Kind::HighPriorityOrder { order: k },
-            ));
-        }
-    }
-    let mut flipped_lots: Vec<(PartKind, String)> = Vec::new();
-    for p in tp.parts.iter().filter(|p| p.flipped) {
-        let place = match p.origin {
-            Origin::Bin { bin, .. } => cell.bin(bin),
-            Origin::Agv { agv, .. } => cell.agv(agv),
-            Origin::Conveyor { .. } => cell.conveyor(),
-        };
-        if !flipped_lots.contains(&(p.kind, place.clone())) {
-            flipped_lots.push((p.kind, place));
-        }
-    }
-    for (kind, place) in flipped_lots {
-        out.push(Challenge::new(
-            format!("flipped_part({kind} in {place})"),
-            Kind::FlippedParts { kind, place },
-        ));
-    }
-    out
 }
 
 impl<'w, 'd> Sim<'w, 'd> {
@@ -129,7 +93,7 @@ impl<'w, 'd> Sim<'w, 'd> {
             w,
             tm: TaskManager::new(trial),
             agents,
-            challenges: challenges(cell, trial, tp),
+            challenges: challenges::at_start(cell, trial, &tp.parts),
             trace: Trace::new(opts.trace),
             tick: 0,
             rng,
@@ -172,7 +136,9 @@ impl<'w, 'd> Sim<'w, 'd> {
         Ok(())
     }
 
-    /// One tick.
+    /// One tick, as the paper's figure reads: the world, the task manager,
+    /// the agents, then what their tick set off. The trace observes each
+    /// as it happens.
     fn step(&mut self) {
         self.tick += 1;
         self.placed.clear();
@@ -181,7 +147,9 @@ impl<'w, 'd> Sim<'w, 'd> {
         self.announce_orders();
         self.allocate();
         self.tick_agents();
-        self.after_tick();
+        self.placements_and_picks();
+        self.progress_orders();
+        self.conditions();
     }
 
     /// The belt, the AGVs arriving (and submitting), the challenges' times.

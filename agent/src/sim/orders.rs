@@ -1,7 +1,7 @@
 //! Orders through the trial: announced when their condition comes true,
 //! quality-checked (faulty parts found and replaced), shipped and
-//! submitted, and scored on submission; and the placements, picks and
-//! submissions of a tick that set off conditions.
+//! submitted, and scored on submission; and the orders and challenges a
+//! tick's placements and submissions announce or start.
 
 use super::events::{AgvMove, Event, OrderEvent};
 use super::model::Sim;
@@ -10,7 +10,6 @@ use super::tasks::{Resource, TaskState, Work};
 use super::world::PartId;
 use crate::cell::Var;
 use crate::trial::{Condition, Destination, OrderType, Task as OrderTask};
-use btc_pddl::state::Key;
 
 impl Sim<'_, '_> {
     pub(super) fn announce_orders(&mut self) {
@@ -43,51 +42,17 @@ impl Sim<'_, '_> {
         }
     }
 
-    pub(super) fn after_tick(&mut self) {
-        // Placements on AGVs.
-        let kit = self.w.facts_of(&self.w.facts.in_kit);
-        let new_kit: Vec<Key> = kit.difference(&self.prev_kit).cloned().collect();
-        self.prev_kit = kit;
-        for k in new_kit {
-            let (Some(p), Some(agv), Some(q)) = (
-                self.w.facts.in_kit.get(&k, Var::Part),
-                self.w.facts.in_kit.get(&k, Var::Agv),
-                self.w.facts.in_kit.get(&k, Var::Quadrant),
-            ) else {
-                continue;
-            };
-            let (Some(&part), Some(n), Some(qn)) = (
-                self.w.part_of.get(&p),
-                self.w.obj.agv.iter().position(|&x| x == agv),
-                self.w.obj.quadrant.iter().position(|&x| x == q),
-            ) else {
-                continue;
-            };
-            self.placed.push((part, n as u8 + 1));
-            self.faulty_on_place(part, n as u8 + 1, qn as u8 + 1);
-        }
-        // Picks.
-        let holding = self.w.facts_of(&self.w.facts.holding);
-        let picks: Vec<Key> = holding.difference(&self.prev_holding).cloned().collect();
-        self.prev_holding = holding;
-        for k in picks {
-            let (Some(r), Some(p)) = (
-                self.w.facts.holding.get(&k, Var::Robot),
-                self.w.facts.holding.get(&k, Var::Part),
-            ) else {
-                continue;
-            };
-            if let (Some(a), Some(&part)) = (
-                self.agents.iter().position(|x| x.obj == r),
-                self.w.part_of.get(&p),
-            ) {
-                self.on_pick(a, part);
-            }
-        }
-        // Orders: quality checks and submissions.
+    /// Orders after the agents' tick: quality checks, shipping and
+    /// submission.
+    pub(super) fn progress_orders(&mut self) {
         for o in 0..self.tm.orders.len() {
             self.progress_order(o);
         }
+    }
+
+    /// Orders and challenges whose condition this tick's placements and
+    /// submissions met.
+    pub(super) fn conditions(&mut self) {
         // Conditions on placements and submissions.
         let placed = std::mem::take(&mut self.placed);
         let submitted = std::mem::take(&mut self.submitted_now);
