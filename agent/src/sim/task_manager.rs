@@ -98,9 +98,17 @@ impl<'w> TaskManager<'w> {
         }
     }
 
-    /// The id of task `t`'s order.
-    fn order_id(&self, t: TaskId) -> String {
-        self.trial.orders[self.tasks[t].order].id.clone()
+    /// Something happened to task `t`.
+    fn task_event(&self, t: TaskId, what: TaskEvent, tick: u64, trace: &mut Trace) {
+        let order = self.trial.orders[self.tasks[t].order].id.clone();
+        trace.event(
+            tick,
+            &Event::Task {
+                task: t,
+                order,
+                what,
+            },
+        );
     }
 
     /// Order `k` is announced: its part tasks join their queues.
@@ -261,16 +269,13 @@ impl<'w> TaskManager<'w> {
         self.tasks[t].state = TaskState::Split {
             into: vec![kit, asm],
         };
-        let order = self.order_id(t);
-        trace.event(
-            tick,
-            &Event::Task {
-                task: t,
-                order,
-                what: TaskEvent::Split {
-                    into: vec![kit, asm],
-                },
+        self.task_event(
+            t,
+            TaskEvent::Split {
+                into: vec![kit, asm],
             },
+            tick,
+            trace,
         );
     }
 
@@ -295,31 +300,20 @@ impl<'w> TaskManager<'w> {
             trace,
         );
         self.tasks[t].state = TaskState::Split { into: vec![asm] };
-        let order = self.order_id(t);
-        trace.event(
-            tick,
-            &Event::Task {
-                task: t,
-                order,
-                what: TaskEvent::Converted { into: vec![asm] },
-            },
-        );
+        self.task_event(t, TaskEvent::Converted { into: vec![asm] }, tick, trace);
         Some(asm)
     }
 
     /// Task `t`'s goal already held.
     pub fn done_already(&mut self, t: TaskId, tick: u64, trace: &mut Trace) {
         self.tasks[t].state = TaskState::Done { tick };
-        let order = self.order_id(t);
-        trace.event(
-            tick,
-            &Event::Task {
-                task: t,
-                order,
-                what: TaskEvent::Done {
-                    how: Some("its goal already held"),
-                },
+        self.task_event(
+            t,
+            TaskEvent::Done {
+                how: Some("its goal already held"),
             },
+            tick,
+            trace,
         );
     }
 
@@ -327,31 +321,20 @@ impl<'w> TaskManager<'w> {
     pub fn done(&mut self, t: TaskId, attempt: Attempt, tick: u64, trace: &mut Trace) {
         self.tasks[t].attempts.push(attempt);
         self.tasks[t].state = TaskState::Done { tick };
-        let order = self.order_id(t);
-        trace.event(
-            tick,
-            &Event::Task {
-                task: t,
-                order,
-                what: TaskEvent::Done { how: None },
-            },
-        );
+        self.task_event(t, TaskEvent::Done { how: None }, tick, trace);
     }
 
     /// Task `t` is given up; the assembly half that waited for a failed
     /// kitting half takes its part from the bins instead.
     pub fn fail(&mut self, t: TaskId, cause: &Cause, tick: u64, trace: &mut Trace) {
         let cause = cause.to_string();
-        let order = self.order_id(t);
-        trace.event(
-            tick,
-            &Event::Task {
-                task: t,
-                order,
-                what: TaskEvent::Failed {
-                    cause: cause.clone(),
-                },
+        self.task_event(
+            t,
+            TaskEvent::Failed {
+                cause: cause.clone(),
             },
+            tick,
+            trace,
         );
         self.tasks[t].state = TaskState::Failed { tick, cause };
         for d in &mut self.tasks {
@@ -390,15 +373,7 @@ impl<'w> TaskManager<'w> {
             });
         }
         self.requeue(t);
-        let order = self.order_id(t);
-        trace.event(
-            tick,
-            &Event::Task {
-                task: t,
-                order,
-                what: TaskEvent::Requeued { why },
-            },
-        );
+        self.task_event(t, TaskEvent::Requeued { why }, tick, trace);
         None
     }
 
@@ -413,15 +388,7 @@ impl<'w> TaskManager<'w> {
     ) {
         self.tasks[t].attempts.push(attempt);
         self.requeue(t);
-        let order = self.order_id(t);
-        trace.event(
-            tick,
-            &Event::Task {
-                task: t,
-                order,
-                what: TaskEvent::Preempted { by },
-            },
-        );
+        self.task_event(t, TaskEvent::Preempted { by }, tick, trace);
     }
 
     fn requeue(&mut self, t: TaskId) {
@@ -484,142 +451,142 @@ mod tests {
         }
     }
 
-    fn announced(ty: OrderType) -> (Trial, Trace) {
+    /// `f` on a task manager that announced a random order of type `ty`
+    /// at tick 1, with a trace.
+    fn announced(ty: OrderType, f: impl FnOnce(&mut TaskManager, &mut Trace)) {
         let trial = random::experiment(ty, Scenario::Normal, 1);
-        (trial, Trace::new(true))
+        let mut trace = Trace::new(true);
+        let mut tm = TaskManager::new(&trial);
+        tm.announce(0, 1, &mut trace);
+        f(&mut tm, &mut trace);
     }
 
     #[test]
     fn a_kitting_order_is_a_tray_task_and_kit_tasks_after_it() {
-        let (trial, mut trace) = announced(OrderType::Kitting);
-        let mut tm = TaskManager::new(&trial);
-        tm.announce(0, 1, &mut trace);
-        let n = tm.tasks.len();
-        assert!(n > 1);
-        assert!(matches!(tm.tasks[0].work, Work::Tray { .. }));
-        assert_eq!(tm.tasks[0].state, TaskState::Queued);
-        for t in &tm.tasks[1..] {
-            assert!(matches!(t.work, Work::Kit { .. }));
-            assert_eq!(
-                (t.state.clone(), t.after.clone()),
-                (TaskState::Blocked, vec![0])
-            );
-        }
-        tm.unblock();
-        assert_eq!(tm.tasks[1].state, TaskState::Blocked, "the tray is open");
-        tm.done(0, attempt("done"), 3, &mut trace);
-        tm.unblock();
-        assert!(tm.tasks[1..].iter().all(|t| t.state == TaskState::Queued));
-        assert_eq!(tm.queued(OrderType::Kitting, false).count(), n - 1);
-        assert_eq!(tm.orders[0].announced, Some(1));
-        assert!(trace.finish().contains("\"what\":\"announced\""));
+        announced(OrderType::Kitting, |tm, trace| {
+            let n = tm.tasks.len();
+            assert!(n > 1);
+            assert!(matches!(tm.tasks[0].work, Work::Tray { .. }));
+            assert_eq!(tm.tasks[0].state, TaskState::Queued);
+            for t in &tm.tasks[1..] {
+                assert!(matches!(t.work, Work::Kit { .. }));
+                assert_eq!(
+                    (t.state.clone(), t.after.clone()),
+                    (TaskState::Blocked, vec![0])
+                );
+            }
+            tm.unblock();
+            assert_eq!(tm.tasks[1].state, TaskState::Blocked, "the tray is open");
+            tm.done(0, attempt("done"), 3, trace);
+            tm.unblock();
+            assert!(tm.tasks[1..].iter().all(|t| t.state == TaskState::Queued));
+            assert_eq!(tm.queued(OrderType::Kitting, false).count(), n - 1);
+            assert_eq!(tm.orders[0].announced, Some(1));
+            assert!(trace.finish().contains("\"what\":\"announced\""));
+        });
     }
 
     #[test]
     fn split_makes_a_kitting_half_and_an_assembly_half_that_waits_for_it() {
-        let (trial, mut trace) = announced(OrderType::Combined);
-        let mut tm = TaskManager::new(&trial);
-        tm.announce(0, 1, &mut trace);
-        assert!(matches!(tm.tasks[0].work, Work::Combined { .. }));
-        tm.split(0, 2, 3, 4, &mut trace);
-        assert_eq!(tm.tasks[0].state, TaskState::Split { into: vec![4, 5] });
-        let kit = tm.tasks.len() - 2;
-        assert_eq!(kit, 4);
-        assert!(matches!(
-            tm.tasks[kit].work,
-            Work::Kit {
-                agv: 2,
-                quadrant: 3,
-                ..
-            }
-        ));
-        assert_eq!(tm.tasks[kit].queue, OrderType::Kitting);
-        let asm = &tm.tasks[kit + 1];
-        assert!(
-            matches!(&asm.work, Work::Assemble { from_task: Some(k), agvs, .. } if *k == kit && *agvs == [2])
-        );
-        assert_eq!(
-            (asm.state.clone(), asm.after.clone()),
-            (TaskState::Blocked, vec![kit])
-        );
-        assert_eq!(tm.orders[0].agv, Some(2));
-        // The assembly half waits for the kitting half and the quality check.
-        tm.done(kit, attempt("done"), 5, &mut trace);
-        tm.unblock();
-        assert_eq!(tm.tasks[kit + 1].state, TaskState::Blocked);
-        tm.orders[0].qc_done = true;
-        tm.unblock();
-        assert_eq!(tm.tasks[kit + 1].state, TaskState::Queued);
+        announced(OrderType::Combined, |tm, trace| {
+            assert!(matches!(tm.tasks[0].work, Work::Combined { .. }));
+            tm.split(0, 2, 3, 4, trace);
+            assert_eq!(tm.tasks[0].state, TaskState::Split { into: vec![4, 5] });
+            let kit = tm.tasks.len() - 2;
+            assert_eq!(kit, 4);
+            assert!(matches!(
+                tm.tasks[kit].work,
+                Work::Kit {
+                    agv: 2,
+                    quadrant: 3,
+                    ..
+                }
+            ));
+            assert_eq!(tm.tasks[kit].queue, OrderType::Kitting);
+            let asm = &tm.tasks[kit + 1];
+            assert!(
+                matches!(&asm.work, Work::Assemble { from_task: Some(k), agvs, .. } if *k == kit && *agvs == [2])
+            );
+            assert_eq!(
+                (asm.state.clone(), asm.after.clone()),
+                (TaskState::Blocked, vec![kit])
+            );
+            assert_eq!(tm.orders[0].agv, Some(2));
+            // The assembly half waits for the kitting half and the quality check.
+            tm.done(kit, attempt("done"), 5, trace);
+            tm.unblock();
+            assert_eq!(tm.tasks[kit + 1].state, TaskState::Blocked);
+            tm.orders[0].qc_done = true;
+            tm.unblock();
+            assert_eq!(tm.tasks[kit + 1].state, TaskState::Queued);
+        });
     }
 
     #[test]
     fn convert_makes_one_assembly_task_from_the_bins() {
-        let (trial, mut trace) = announced(OrderType::Combined);
-        let mut tm = TaskManager::new(&trial);
-        tm.announce(0, 1, &mut trace);
-        let asm = tm.convert(1, 2, &mut trace).unwrap();
-        assert_eq!(tm.tasks[1].state, TaskState::Split { into: vec![asm] });
-        assert!(
-            matches!(&tm.tasks[asm].work, Work::Assemble { from_task: None, agvs, .. } if agvs.is_empty())
-        );
-        assert_eq!(tm.tasks[asm].state, TaskState::Queued);
-        assert_eq!(tm.convert(asm, 2, &mut trace), None, "only a combined task");
-        assert!(trace.finish().contains("\"what\":\"converted\""));
+        announced(OrderType::Combined, |tm, trace| {
+            let asm = tm.convert(1, 2, trace).unwrap();
+            assert_eq!(tm.tasks[1].state, TaskState::Split { into: vec![asm] });
+            assert!(
+                matches!(&tm.tasks[asm].work, Work::Assemble { from_task: None, agvs, .. } if agvs.is_empty())
+            );
+            assert_eq!(tm.tasks[asm].state, TaskState::Queued);
+            assert_eq!(tm.convert(asm, 2, trace), None, "only a combined task");
+            assert!(trace.finish().contains("\"what\":\"converted\""));
+        });
     }
 
     #[test]
     fn a_failed_attempt_is_requeued_until_the_last_then_given_up() {
-        let (trial, mut trace) = announced(OrderType::Assembly);
-        let mut tm = TaskManager::new(&trial);
-        tm.announce(0, 1, &mut trace);
-        let why = || "`pick` failed: dropped".to_owned();
-        assert_eq!(
-            tm.attempt_failed(0, attempt("failed"), why(), 2, 3, &mut trace),
-            None
-        );
-        assert_eq!(
-            (tm.tasks[0].state.clone(), tm.tasks[0].reassignments),
-            (TaskState::Queued, 1)
-        );
-        let cause = tm
-            .attempt_failed(0, attempt("failed"), why(), 2, 4, &mut trace)
-            .unwrap();
-        assert_eq!(
-            cause.to_string(),
-            "gave up after 2 attempts; the last: `pick` failed: dropped"
-        );
-        tm.fail(0, &cause, 4, &mut trace);
-        assert!(
-            matches!(&tm.tasks[0].state, TaskState::Failed { tick: 4, cause: c } if *c == cause.to_string())
-        );
-        assert!(!tm.order_ended(0), "the other parts are still open");
-        tm.preempted(1, attempt("preempted"), "o2".into(), 5, &mut trace);
-        assert_eq!(
-            (tm.tasks[1].state.clone(), tm.tasks[1].reassignments),
-            (TaskState::Queued, 1)
-        );
+        announced(OrderType::Assembly, |tm, trace| {
+            let why = || "`pick` failed: dropped".to_owned();
+            assert_eq!(
+                tm.attempt_failed(0, attempt("failed"), why(), 2, 3, trace),
+                None
+            );
+            assert_eq!(
+                (tm.tasks[0].state.clone(), tm.tasks[0].reassignments),
+                (TaskState::Queued, 1)
+            );
+            let cause = tm
+                .attempt_failed(0, attempt("failed"), why(), 2, 4, trace)
+                .unwrap();
+            assert_eq!(
+                cause.to_string(),
+                "gave up after 2 attempts; the last: `pick` failed: dropped"
+            );
+            tm.fail(0, &cause, 4, trace);
+            assert!(
+                matches!(&tm.tasks[0].state, TaskState::Failed { tick: 4, cause: c } if *c == cause.to_string())
+            );
+            assert!(!tm.order_ended(0), "the other parts are still open");
+            tm.preempted(1, attempt("preempted"), "o2".into(), 5, trace);
+            assert_eq!(
+                (tm.tasks[1].state.clone(), tm.tasks[1].reassignments),
+                (TaskState::Queued, 1)
+            );
+        });
     }
 
     #[test]
     fn when_a_kitting_half_fails_its_assembly_half_takes_a_part_from_the_bins() {
-        let (trial, mut trace) = announced(OrderType::Combined);
-        let mut tm = TaskManager::new(&trial);
-        tm.announce(0, 1, &mut trace);
-        tm.split(0, 1, 1, 2, &mut trace);
-        let (kit, asm) = (tm.tasks.len() - 2, tm.tasks.len() - 1);
-        let cause = Cause::InsufficientParts {
-            part: crate::trial::PartKind {
-                ty: crate::trial::PartType::Pump,
-                color: crate::trial::Color::Red,
-            },
-            from_agvs: Vec::new(),
-        };
-        assert!(cause.insufficient());
-        tm.fail(kit, &cause, 3, &mut trace);
-        assert!(
-            matches!(&tm.tasks[asm].work, Work::Assemble { from_task: None, agvs, .. } if agvs.is_empty())
-        );
-        tm.unblock();
-        assert_eq!(tm.tasks[asm].state, TaskState::Queued);
+        announced(OrderType::Combined, |tm, trace| {
+            tm.split(0, 1, 1, 2, trace);
+            let (kit, asm) = (tm.tasks.len() - 2, tm.tasks.len() - 1);
+            let cause = Cause::InsufficientParts {
+                part: crate::trial::PartKind {
+                    ty: crate::trial::PartType::Pump,
+                    color: crate::trial::Color::Red,
+                },
+                from_agvs: Vec::new(),
+            };
+            assert!(cause.insufficient());
+            tm.fail(kit, &cause, 3, trace);
+            assert!(
+                matches!(&tm.tasks[asm].work, Work::Assemble { from_task: None, agvs, .. } if agvs.is_empty())
+            );
+            tm.unblock();
+            assert_eq!(tm.tasks[asm].state, TaskState::Queued);
+        });
     }
 }
