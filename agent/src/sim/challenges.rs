@@ -7,6 +7,7 @@
 //! disabled, a part dropped) the simulation applies; here is only when and
 //! to whom, and the runtime faults it means for a robot's tree.
 
+use super::tasks::PartId;
 use crate::cell::spec::Time;
 use crate::cell::{Cell, Origin, PartInfo};
 use crate::trial::{Behavior, ChallengeKind, Condition, PartKind, Robot, Trial};
@@ -54,12 +55,12 @@ pub struct DroppedPart {
     /// Picks of the kind seen.
     picks: u32,
     /// The drop to come: its tick and the part.
-    pub drop: Option<(u64, usize)>,
+    pub drop: Option<(u64, PartId)>,
 }
 
 impl DroppedPart {
     /// A pick by `robot` of `part` (of `kind`) at `tick`.
-    pub fn picked(&mut self, robot: Robot, kind: PartKind, part: usize, tick: u64, time: &Time) {
+    pub fn picked(&mut self, robot: Robot, kind: PartKind, part: PartId, tick: u64, time: &Time) {
         if robot != self.robot || kind != self.kind || self.drop.is_some() {
             return;
         }
@@ -70,7 +71,7 @@ impl DroppedPart {
     }
 
     /// The part to drop now, if its time came.
-    pub fn due(&self, tick: u64) -> Option<usize> {
+    pub fn due(&self, tick: u64) -> Option<PartId> {
         self.drop.filter(|(at, _)| *at <= tick).map(|(_, p)| p)
     }
 }
@@ -433,21 +434,21 @@ mod tests {
         }) else {
             unreachable!()
         };
-        d.picked(Robot::CeilingRobot, kind(), 7, 1, &time());
+        d.picked(Robot::CeilingRobot, kind(), PartId(7), 1, &time());
         let other = PartKind {
             color: Color::Blue,
             ..kind()
         };
-        d.picked(Robot::FloorRobot, other, 7, 1, &time());
+        d.picked(Robot::FloorRobot, other, PartId(7), 1, &time());
         assert_eq!(d.drop, None, "another robot's or kind's picks do not count");
-        d.picked(Robot::FloorRobot, kind(), 3, 2, &time());
+        d.picked(Robot::FloorRobot, kind(), PartId(3), 2, &time());
         assert_eq!(d.drop, None, "the first pick is kept");
-        d.picked(Robot::FloorRobot, kind(), 4, 10, &time());
-        assert_eq!(d.drop, Some((14, 4)));
+        d.picked(Robot::FloorRobot, kind(), PartId(4), 10, &time());
+        assert_eq!(d.drop, Some((14, PartId(4))));
         assert_eq!(d.due(13), None);
-        assert_eq!(d.due(14), Some(4));
-        d.picked(Robot::FloorRobot, kind(), 5, 11, &time());
-        assert_eq!(d.drop, Some((14, 4)), "one drop at a time");
+        assert_eq!(d.due(14), Some(PartId(4)));
+        d.picked(Robot::FloorRobot, kind(), PartId(5), 11, &time());
+        assert_eq!(d.drop, Some((14, PartId(4))), "one drop at a time");
     }
 
     fn challenge(c: ChallengeKind) -> Challenge {

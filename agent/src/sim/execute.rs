@@ -10,7 +10,7 @@ use super::allocation;
 use super::challenges::Kind;
 use super::events::{Cause, Event};
 use super::model::Sim;
-use super::tasks::{Attempt, Resource, TaskId, TaskState};
+use super::tasks::{Attempt, PartId, Resource, TaskId, TaskState};
 use crate::cell::{conjunction, Literal, Var};
 use btc_lang::db;
 use btc_pddl::source::Span;
@@ -25,7 +25,7 @@ impl<'w> Sim<'w, '_> {
         &mut self,
         a: usize,
         t: TaskId,
-        part: Option<usize>,
+        part: Option<PartId>,
         resources: Vec<Resource>,
         mut goal: Vec<Literal>,
     ) {

@@ -15,7 +15,7 @@ impl Sim<'_, '_> {
             tick: self.tick,
             what,
         };
-        for p in &self.w.parts {
+        for p in self.w.parts.iter() {
             let places = self.w.facts.places(s, p.obj);
             let in_cell = p.gone.is_none() && p.spawn.is_none_or(|t| t <= self.tick);
             let expect = usize::from(in_cell);
@@ -52,7 +52,7 @@ impl Sim<'_, '_> {
                 }
             }
         }
-        for (k, p) in self.w.parts.iter().enumerate() {
+        for (k, p) in self.w.parts.with_ids() {
             if let Some(t) = p.reserved {
                 if !matches!(self.tm.tasks[t].state, TaskState::Running { .. }) {
                     return Err(bad(format!(

@@ -35,7 +35,7 @@ impl Sim<'_, '_> {
         t: TaskId,
         kind: PartKind,
         from_agvs: &[u8],
-    ) -> Result<Option<usize>, ()> {
+    ) -> Result<Option<PartId>, ()> {
         let robot = self.agents[a].obj;
         let s = &self.w.kb.state;
         // The part the task's last attempt used, wherever it lies now (the
@@ -56,9 +56,9 @@ impl Sim<'_, '_> {
                 return Ok(Some(k));
             }
         }
-        let mut best: Option<(u8, usize)> = None;
+        let mut best: Option<(u8, PartId)> = None;
         let mut someone_has = false;
-        for (k, p) in self.w.parts.iter().enumerate() {
+        for (k, p) in self.w.parts.with_ids() {
             if p.info.kind != kind || p.gone.is_some() || p.faulty {
                 continue;
             }

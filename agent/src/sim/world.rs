@@ -16,8 +16,7 @@ use btc_pddl::ProblemIndex;
 use btc_runtime::Kb;
 use rustc_hash::{FxHashMap, FxHashSet};
 
-/// A part of the trial: one of `CellWorld::parts`.
-pub type PartId = usize;
+pub use super::tasks::PartId;
 
 pub struct PartRt {
     pub info: PartInfo,
@@ -30,6 +29,38 @@ pub struct PartRt {
     pub faulty: bool,
     /// The task that holds it.
     pub reserved: Option<TaskId>,
+}
+
+/// The trial's parts, by id.
+pub struct Parts(Vec<PartRt>);
+
+impl Parts {
+    pub fn iter(&self) -> impl Iterator<Item = &PartRt> {
+        self.0.iter()
+    }
+
+    /// Each part with its id.
+    pub fn with_ids(&self) -> impl Iterator<Item = (PartId, &PartRt)> {
+        self.0.iter().enumerate().map(|(k, p)| (PartId(k), p))
+    }
+
+    pub fn ids(&self) -> impl Iterator<Item = PartId> {
+        (0..self.0.len()).map(PartId)
+    }
+}
+
+impl std::ops::Index<PartId> for Parts {
+    type Output = PartRt;
+
+    fn index(&self, k: PartId) -> &PartRt {
+        &self.0[k.0]
+    }
+}
+
+impl std::ops::IndexMut<PartId> for Parts {
+    fn index_mut(&mut self, k: PartId) -> &mut PartRt {
+        &mut self.0[k.0]
+    }
 }
 
 /// An AGV on its way to `to`.
@@ -109,7 +140,7 @@ pub struct CellWorld<'w> {
     pub facts: Facts,
     pub obj: Objects,
     pub pix: &'w ProblemIndex,
-    pub parts: Vec<PartRt>,
+    pub parts: Parts,
     pub part_of: FxHashMap<u32, PartId>,
     pub travels: Vec<Travel>,
     /// Resources held, and by whom.
@@ -150,7 +181,7 @@ impl<'w> CellWorld<'w> {
         // The belt's schedule: one part every `spawn_rate` seconds from the
         // start, in the file's order or shuffled.
         if let Some(c) = trial.conveyor.as_ref().filter(|c| c.active) {
-            let mut order: Vec<PartId> = (0..parts.len())
+            let mut order: Vec<usize> = (0..parts.len())
                 .filter(|&k| matches!(parts[k].info.origin, Origin::Conveyor { .. }))
                 .collect();
             if c.order == SpawnOrder::Random {
@@ -162,14 +193,18 @@ impl<'w> CellWorld<'w> {
                 parts[k].leave = Some(at + time.ticks(time.conveyor_seconds).max(1));
             }
         }
-        let part_of = parts.iter().enumerate().map(|(k, p)| (p.obj, k)).collect();
+        let part_of = parts
+            .iter()
+            .enumerate()
+            .map(|(k, p)| (p.obj, PartId(k)))
+            .collect();
         let a = between()?;
         let world = CellWorld {
             kb,
             facts,
             obj: Objects::new(cell, pix)?,
             pix,
-            parts,
+            parts: Parts(parts),
             part_of,
             travels: Vec::new(),
             held: Vec::new(),
@@ -289,7 +324,7 @@ impl<'w> CellWorld<'w> {
 
     /// The belt at `tick`: parts arrive on it and ride off its end.
     pub fn belt(&mut self, tick: u64, trace: &mut Trace) {
-        for k in 0..self.parts.len() {
+        for k in self.parts.ids() {
             if self.parts[k].spawn == Some(tick) {
                 let p = self.parts[k].obj;
                 let mut add = vec![self
