@@ -1,17 +1,12 @@
 //! What a trial came to: the scoreboard per order and per agent, the
 //! challenges and how each ended, every part task with its attempts.
 
-use super::scoring::{InsertScore, KitScore};
-use super::tasks::Task;
+use super::model::Sim;
+use super::scoring;
+pub use super::scoring::Breakdown;
+use super::tasks::{Task, TaskState};
 use crate::trial::OrderType;
 use serde::Serialize;
-
-#[derive(Clone, Debug, PartialEq, Serialize)]
-#[serde(untagged)]
-pub enum Breakdown {
-    Kit(KitScore),
-    Insert(InsertScore),
-}
 
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct FaultMet {
@@ -181,6 +176,112 @@ impl TrialsSummary {
             score: f(&|r| r.score as f64),
             seconds: f(&|r| r.seconds),
             orders,
+        }
+    }
+}
+
+impl Sim<'_, '_> {
+    /// What the trial came to.
+    pub(super) fn report(&mut self, name: &str) -> TrialReport {
+        let mut orders = Vec::new();
+        for (k, o) in self.trial.orders.iter().enumerate() {
+            let rt = &self.tm.orders[k];
+            let tasks: Vec<&Task> = rt
+                .tasks
+                .iter()
+                .map(|&t| &self.tm.tasks[t])
+                .filter(|t| !matches!(t.state, TaskState::Split { .. }))
+                .collect();
+            let faults: Vec<FaultMet> = self
+                .challenges
+                .iter()
+                .filter(|c| c.orders.contains(&k) && c.met_at.is_some())
+                .map(|c| FaultMet {
+                    challenge: c.label.clone(),
+                    at: self.secs(c.met_at.unwrap_or(1) - 1),
+                    ended: c.end(Some(
+                        self.tm.orders[k].score
+                            == scoring::best(o.task.order_type(), o.task.kinds().len()),
+                    )),
+                })
+                .collect();
+            orders.push(OrderReport {
+                id: o.id.clone(),
+                ty: o.task.order_type(),
+                priority: o.priority,
+                state: match (rt.announced, rt.submitted) {
+                    (None, _) => "not announced".into(),
+                    (Some(_), None) => "not submitted".into(),
+                    (Some(_), Some(_)) => "submitted".into(),
+                },
+                announced: rt.announced.map(|t| self.secs(t - 1)),
+                submitted: rt.submitted.map(|t| self.secs(t)),
+                time: match (rt.announced, rt.submitted) {
+                    (Some(a), Some(s)) => Some(self.secs(s + 1 - a)),
+                    _ => None,
+                },
+                score: if rt.submitted.is_some() { rt.score } else { 0 },
+                best: scoring::best(o.task.order_type(), o.task.kinds().len()),
+                breakdown: rt.breakdown.clone(),
+                part_tasks: tasks.len(),
+                done: tasks.iter().filter(|t| t.is_done()).count(),
+                failed: tasks
+                    .iter()
+                    .filter(|t| matches!(t.state, TaskState::Failed { .. }))
+                    .count(),
+                reassignments: tasks.iter().map(|t| t.reassignments).sum(),
+                faults,
+            });
+        }
+        let agents = self
+            .agents
+            .iter()
+            .map(|a| AgentReport {
+                robot: self.cell.robot(a.robot).object.clone(),
+                busy: self.secs(a.busy),
+                tasks_done: a.done,
+                tasks_failed: self
+                    .tm
+                    .tasks
+                    .iter()
+                    .filter(|t| {
+                        matches!(t.state, TaskState::Failed { .. })
+                            && t.attempts
+                                .last()
+                                .is_some_and(|x| x.agent == self.cell.robot(a.robot).object)
+                    })
+                    .count(),
+                plans: a.plans,
+                planning_ms: a.planning_ms,
+            })
+            .collect();
+        let challenges = self
+            .challenges
+            .iter()
+            .map(|c| ChallengeReport {
+                challenge: c.label.clone(),
+                kind: c.kind.name().to_owned(),
+                met: c.met_at.map(|t| self.secs(t - 1)),
+                ended: c.end(None),
+            })
+            .collect();
+        let trace = self.trace.finish();
+        let score = orders.iter().map(|o| o.score).sum();
+        let best = orders.iter().map(|o| o.best).sum();
+        TrialReport {
+            trial: name.to_owned(),
+            seed: self.opts.seed,
+            seconds: self.secs(self.tick),
+            ticks: self.tick,
+            score,
+            best,
+            orders,
+            agents,
+            challenges,
+            tasks: self.tm.tasks.clone(),
+            stopped: self.stopped.clone(),
+            elapsed_ms: 0.0,
+            trace,
         }
     }
 }

@@ -22,8 +22,21 @@
 //! | combined | slot: 5 / 4 / 3 (same conditions as assembly) | |
 //! | combined | bonus when every slot scores 5 | 4n |
 //! | assembly, combined | station multiplier | 1 at the right station, else 0 |
+//!
+//! [`order`] reads a submitted order's conditions off the cell's world.
 
+use super::world::CellWorld;
+use crate::cell::{Cell, Var};
+use crate::trial::{Destination, Order, OrderType, Task as OrderTask};
 use serde::Serialize;
+
+/// An order's score, item by item.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum Breakdown {
+    Kit(KitScore),
+    Insert(InsertScore),
+}
 
 /// What is in one quadrant of a submitted kit.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -151,5 +164,87 @@ pub fn best(kind: crate::trial::OrderType, n: usize) -> i64 {
         crate::trial::OrderType::Kitting => 3 + 3 * n + n,
         crate::trial::OrderType::Assembly => 3 * n + 4 * n,
         crate::trial::OrderType::Combined => 5 * n + 4 * n,
+    }
+}
+
+/// The score of an order submitted now.
+pub fn order(w: &CellWorld, cell: &Cell, order: &Order) -> (i64, Breakdown) {
+    let s = &w.kb.state;
+    match &order.task {
+        OrderTask::Kitting {
+            agv,
+            tray_id,
+            destination,
+            products,
+        } => {
+            let aobj = w.obj.agv[*agv as usize - 1];
+            let tray = w.facts.tray_of(s, aobj).map(|t| w.name(t).to_owned());
+            let correct_tray = tray.as_deref() == Some(cell.tray(*tray_id).as_str());
+            let kit = w.facts.kit(s, aobj);
+            let quadrants: Vec<Quadrant> = products
+                .iter()
+                .map(|p| {
+                    let q = w.obj.quadrant[p.quadrant as usize - 1];
+                    let there = kit.iter().find(|(qq, _)| *qq == q).map(|(_, part)| *part);
+                    let kind = there.and_then(|x| w.kind_of(x));
+                    Quadrant {
+                        quadrant: p.quadrant,
+                        present: there.is_some(),
+                        correct_type: kind.is_some_and(|k| k.ty == p.kind.ty),
+                        correct_color: kind.is_some_and(|k| k.color == p.kind.color),
+                        flipped: there.is_some_and(|x| {
+                            s.facts.contains(&w.facts.flipped.key(&[(Var::Part, x)]))
+                        }),
+                        faulty: there
+                            .and_then(|x| w.part_of.get(&x))
+                            .is_some_and(|&k| w.parts[k].faulty),
+                    }
+                })
+                .collect();
+            let want = match destination {
+                Destination::Warehouse => w.obj.warehouse,
+                Destination::Kitting => w.obj.kitting_station[*agv as usize - 1],
+                Destination::Station(n) => w.obj.station[*n as usize - 1],
+            };
+            let at_dest = w.facts.agv_place(s, aobj) == Some(want);
+            let k = kitting(
+                correct_tray && tray.is_some(),
+                &quadrants,
+                kit.len(),
+                at_dest,
+            );
+            (k.score, Breakdown::Kit(k))
+        }
+        OrderTask::Assembly {
+            station, products, ..
+        }
+        | OrderTask::Combined { station, products } => {
+            let st = w.obj.station[*station as usize - 1];
+            let insert = w.facts.insert(s, st);
+            let slots: Vec<Slot> = products
+                .iter()
+                .map(|p| {
+                    let there = insert
+                        .iter()
+                        .find(|x| w.kind_of(**x).is_some_and(|k| k.ty == p.kind.ty));
+                    Slot {
+                        assembled: there.is_some(),
+                        correct_color: there
+                            .and_then(|x| w.kind_of(*x))
+                            .is_some_and(|k| k.color == p.kind.color),
+                        correct_pose: there.is_some_and(|x| {
+                            !s.facts.contains(&w.facts.flipped.key(&[(Var::Part, *x)]))
+                        }),
+                    }
+                })
+                .collect();
+            let kind = if order.task.order_type() == OrderType::Assembly {
+                Insert::Assembly
+            } else {
+                Insert::Combined
+            };
+            let r = self::insert(kind, &slots, true);
+            (r.score, Breakdown::Insert(r))
+        }
     }
 }

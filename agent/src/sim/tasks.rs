@@ -3,8 +3,29 @@
 
 use crate::trial::{OrderType, PartKind};
 use serde::Serialize;
+use std::fmt;
 
+/// A part task: its place in the trial's list of tasks (the report's
+/// `tasks`), which is also its number.
 pub type TaskId = usize;
+
+/// A part of the trial: its place among the trial's parts. Written as the
+/// number (in the report and in messages).
+#[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[serde(transparent)]
+pub struct PartId(pub usize);
+
+impl fmt::Debug for PartId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.0)
+    }
+}
+
+impl fmt::Display for PartId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.0)
+    }
+}
 
 /// What a part task does.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -24,7 +45,7 @@ pub enum Work {
         part: PartKind,
         agv: u8,
         quadrant: u8,
-        faulty: usize,
+        faulty: PartId,
     },
     /// A part into the station's insert: from the order's AGVs (assembly),
     /// from the bins or the belt (a converted combined task), or the part a
@@ -129,7 +150,7 @@ pub struct Task {
     /// Tasks that must be done first.
     pub after: Vec<TaskId>,
     /// The part object chosen for the running or last attempt.
-    pub part: Option<usize>,
+    pub part: Option<PartId>,
     pub attempts: Vec<Attempt>,
     /// Times it went back to its queue after a failure or a preemption.
     pub reassignments: u32,
@@ -152,7 +173,7 @@ impl Task {
 /// Something a task holds while it runs: one task at a time.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Resource {
-    Part(usize),
+    Part(PartId),
     /// The AGV itself (moving it, its tray).
     Agv(u8),
     /// One quadrant of an AGV's kit.
