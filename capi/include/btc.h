@@ -122,6 +122,52 @@ char *btc_tree_steps(const btc_tree *tree, char **error);
 
 void btc_tree_free(btc_tree *tree);
 
+/* ---- The closed loop ---------------------------------------------------- */
+
+/* The executor of an agent: runs one attempt's tree and answers with
+ * btc_reply_set(). `attempt_json` (valid during the call) is
+ *   {"attempt": 1, "tree_xml": "<root ...>", "nodes": [as btc_tree_nodes],
+ *    "state": ["(at r1 a)", "(= (battery r1) 20.0)"], "goal": "(and ...)",
+ *    "tick": 0, "steps": ["(move r1 a b)", ...]}
+ * (`state`: the facts the attempt starts from; `tick`: ticks run before).
+ * Return 0 with the outcome as the reply:
+ *   {"status": "success" | "failure" | "running",
+ *    "state": [facts after the run], "ticks": 12, "steps_done": 2,
+ *    "records": [{"node_id": "MoveTo", "node_name": "move", "reason": "...",
+ *                 "step": 3 or null}],
+ *    "faults": [{"kind": "faulty_gripper", "part": null, "robot": "r1",
+ *                "goal": null, "retract": ["(attach p r1)"],
+ *                "add": ["(on p bin1)"], "reason": "..." or null}]}
+ * (`kind`: one of ARIAC's faulty_part, faulty_gripper, robot_malfunction,
+ * flipped_part, sensor_blackout, high_priority_order, insufficient_parts,
+ * human_too_close; btc applies `retract` and `add` to the state it replans
+ * from and adjusts the goal as `btc run --replan` does). Return nonzero
+ * when the attempt could not be executed, with the reason as the reply
+ * text: the loop stops with that error (A003). The callback must not
+ * unwind (no C++ exception may leave it). */
+typedef int (*btc_execute_fn)(void *user, const char *attempt_json,
+                              btc_reply *reply);
+
+/* The executor's answer (copied). */
+void btc_reply_set(btc_reply *reply, const char *text);
+
+/* An agent over `project` for `problem` (a path; NULL: the project's). The
+ * agent takes the project, also when it fails: do not free it after. */
+btc_agent *btc_agent_new(btc_project *project, const char *problem,
+                         char **error);
+
+/* Runs the closed loop (the one `btc run --replan` runs): plans, hands each
+ * attempt to `execute`, replans from what it reports, until the goal is
+ * reached or the loop must stop. `options_json` may be NULL or
+ *   {"max_replans": 5, "max_ticks": 100000}
+ * Returns the report as JSON: {"attempts": [...], "replans": [...],
+ * "faults": [...], "goal": "...", "goal_reached": true, "ticks": 7,
+ * "stopped": [diagnostics], ...}. */
+char *btc_agent_run(btc_agent *agent, const char *options_json,
+                    btc_execute_fn execute, void *user, char **error);
+
+void btc_agent_free(btc_agent *agent);
+
 #ifdef __cplusplus
 }
 #endif
