@@ -41,6 +41,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
         ],
     ),
     ("btc-python", &["btc-api"]),
+    ("btc-capi", &["btc-api", "btc-pddl"]),
     ("btc-lsp", &["btc-files", "btc-ir", "btc-lang", "btc-pddl"]),
     ("btc-testkit", &[]),
     ("btc-files", &[]),
