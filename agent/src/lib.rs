@@ -14,5 +14,6 @@ pub mod sim;
 pub mod trial;
 
 pub use replan::{
-    run_loop, run_loop_traced, run_loop_with, InstallLeaves, LoopError, LoopOptions, LoopSummary,
+    run_loop, run_loop_outside, run_loop_traced, run_loop_with, Executed, Executor, Handoff,
+    InstallLeaves, LoopError, LoopOptions, LoopSummary,
 };

@@ -6,6 +6,7 @@
 //! up to a limit. It is the loop `btc run --replan` runs.
 
 use crate::diagnostic::{convert, Diagnostic, Error};
+use crate::executor::{Adapter, Executor};
 use crate::faults::Faults;
 use crate::project::Project;
 use crate::tree::{Handler, RunOptions};
@@ -103,16 +104,7 @@ impl Agent {
             self.project.declared_action(id)?;
         }
         let (db, job) = self.project.loop_job(self.problem.as_deref())?;
-        let opts = LoopOptions {
-            engine: btc_runtime::Options {
-                ticks_per_action: options.run.ticks_per_action,
-                ms_per_tick: options.run.ms_per_tick,
-                trace: false,
-            },
-            planner: btc_planner::Options::default(),
-            max_replans: options.max_replans,
-            max_ticks: options.run.max_ticks,
-        };
+        let opts = loop_options(options);
         let leaves = &self.leaves;
         let mut install = |engine: &mut Engine<'_>| {
             for (id, h) in leaves {
@@ -133,6 +125,32 @@ impl Agent {
             &mut std::io::sink(),
             Some(&mut install),
         );
+        self.report(result, faults)
+    }
+
+    /// Runs the loop with every attempt's tree ticked by `executor` (the
+    /// embedder's py_trees or BehaviorTree.CPP tree with its own
+    /// behaviours) instead of btc's engine. The loop plans, compiles, takes
+    /// the KB, the failure records and the reported faults back from the
+    /// executor, and replans as `btc run --replan` does. Leaves added with
+    /// [`Agent::leaf`] are not used: the executor has its own.
+    pub fn run_with(
+        &mut self,
+        options: &AgentOptions,
+        executor: &mut dyn Executor,
+    ) -> Result<AgentReport, Error> {
+        let opts = loop_options(options);
+        let (db, job) = self.project.loop_job(self.problem.as_deref())?;
+        let mut adapter = Adapter { executor };
+        let result = btc_agent::run_loop_outside(db, job, &opts, &mut adapter);
+        self.report(result, None)
+    }
+
+    fn report(
+        &self,
+        result: Result<btc_agent::LoopSummary, LoopError>,
+        faults: Option<&Faults>,
+    ) -> Result<AgentReport, Error> {
         let summary = match result {
             Ok(s) => s,
             Err(LoopError::Compile(ds)) => return Err(self.project.error(&ds)),
@@ -156,5 +174,18 @@ impl Agent {
             stopped: convert(&summary.diagnostics, &sources),
             unreachable: summary.unreachable,
         })
+    }
+}
+
+fn loop_options(options: &AgentOptions) -> LoopOptions {
+    LoopOptions {
+        engine: btc_runtime::Options {
+            ticks_per_action: options.run.ticks_per_action,
+            ms_per_tick: options.run.ms_per_tick,
+            trace: false,
+        },
+        planner: btc_planner::Options::default(),
+        max_replans: options.max_replans,
+        max_ticks: options.run.max_ticks,
     }
 }

@@ -17,6 +17,17 @@ pub struct Faults {
 }
 
 impl Faults {
+    /// The scenario's faults as behaviours would report them to an agent
+    /// that runs with its own executor ([`crate::Agent::run_with`]), by
+    /// their labels (the `name`, or the kind).
+    pub fn reported(&self) -> Vec<(String, crate::ReportedFault)> {
+        self.scenario
+            .faults
+            .iter()
+            .map(|f| (f.label(), crate::ReportedFault::of(f)))
+            .collect()
+    }
+
     pub fn parse(text: &str) -> Result<Faults, Error> {
         Faults::read(text.to_owned(), FAULTS_TEXT.to_owned())
     }

@@ -17,11 +17,13 @@
 //! - [`Tree`]: a compiled tree; every emitter's text, and a run in btc's
 //!   engine with the embedder's own leaves ([`Tree::run`]).
 //! - [`Agent`]: the closed loop (plan, compile, run, fault, replan) with
-//!   the embedder's leaves: the loop `btc run --replan` runs.
+//!   the embedder's leaves, or with its own executor ([`Executor`]: a
+//!   py_trees or BehaviorTree.CPP tree): the loop `btc run --replan` runs.
 //! - [`Diagnostic`] and [`Error`]: what went wrong, where, what to do.
 
 mod agent;
 mod diagnostic;
+mod executor;
 mod faults;
 mod plan;
 mod project;
@@ -32,6 +34,7 @@ pub use agent::{
 };
 pub use btc_runtime::{ActionCall, Status, Value};
 pub use diagnostic::{Diagnostic, Error, Fix, Label, Position, Severity};
+pub use executor::{AttemptInput, Executed, Executor, Record, ReportedFault};
 pub use faults::Faults;
 pub use plan::{Plan, Step};
 pub use project::{Project, DOMAIN_TEXT, PROBLEM_TEXT, RULES_TEXT};

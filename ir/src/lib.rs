@@ -368,6 +368,12 @@ impl StepInfo {
     pub fn display(&self) -> String {
         self.logic.display()
     }
+
+    /// `step N: (action arg ...)`, N 1-based: how records and traces name
+    /// the step.
+    pub fn label(&self) -> String {
+        format!("step {}: {}", self.index + 1, self.display())
+    }
 }
 
 impl StepLogic {

@@ -4,7 +4,7 @@
 //! faults hook (`engine/faults.rs`).
 
 use crate::error::LoadError;
-use crate::kb::FormulaId;
+use crate::kb::{FormulaId, Kb};
 use btc_pddl::diagnostic::codes;
 use btc_pddl::logic::{decode, Atom, Formula, Terms};
 use btc_pddl::state::Key;
@@ -48,7 +48,7 @@ impl FaultKind {
         }
     }
 
-    fn from_name(s: &str) -> Option<FaultKind> {
+    pub fn from_name(s: &str) -> Option<FaultKind> {
         FaultKind::ALL.into_iter().find(|k| k.name() == s)
     }
 }
@@ -94,6 +94,65 @@ impl FaultSpec {
         self.name
             .clone()
             .unwrap_or_else(|| self.kind.name().to_owned())
+    }
+
+    /// The facts the fault adds to and retracts from `kb`'s state when it
+    /// happens: its `add` and `retract` facts, or for a faulty or missing
+    /// part without a `retract`, every fact naming the part (it is gone).
+    /// Only changes: facts already true are not added again, facts not
+    /// true are not retracted.
+    pub fn changes(&self, kb: &Kb<'_>) -> (Vec<Key>, Vec<Key>) {
+        let mut retract: Vec<Key> = match &self.retract {
+            Some(list) => list.iter().filter_map(|t| kb.atom_key(t).ok()).collect(),
+            None if matches!(
+                self.kind,
+                FaultKind::FaultyPart | FaultKind::InsufficientParts
+            ) =>
+            {
+                self.part
+                    .as_deref()
+                    .and_then(|p| kb.object(p))
+                    .map(|o| kb.facts_mentioning(o))
+                    .unwrap_or_default()
+            }
+            None => Vec::new(),
+        };
+        retract.retain(|k| kb.state.facts.contains(k));
+        let mut add: Vec<Key> = self
+            .add
+            .iter()
+            .filter_map(|t| kb.atom_key(t).ok())
+            .collect();
+        add.retain(|k| !kb.state.facts.contains(k));
+        (add, retract)
+    }
+
+    /// What a fault of this kind must say and does not, in words (`None`:
+    /// nothing is missing). A scenario file and a fault an embedder
+    /// reports are held to the same needs.
+    pub fn missing(&self) -> Option<&'static str> {
+        match self.kind {
+            FaultKind::RobotMalfunction | FaultKind::HumanTooClose if self.robot.is_none() => {
+                Some("this kind needs `robot`")
+            }
+            FaultKind::RobotMalfunction | FaultKind::HumanTooClose if self.duration.is_none() => {
+                Some("this kind needs `duration` (ticks)")
+            }
+            FaultKind::FaultyGripper if self.robot.is_none() => Some("this kind needs `robot`"),
+            FaultKind::FaultyPart | FaultKind::InsufficientParts if self.part.is_none() => {
+                Some("this kind needs `part`")
+            }
+            FaultKind::FlippedPart
+                if self.retract.as_ref().is_none_or(Vec::is_empty) || self.add.is_empty() =>
+            {
+                Some("say how the part lies flipped: `retract` and `add` facts")
+            }
+            FaultKind::SensorBlackout if self.duration.is_none() => {
+                Some("this kind needs `duration` (ticks)")
+            }
+            FaultKind::HighPriorityOrder if self.goal.is_none() => Some("this kind needs `goal`"),
+            _ => None,
+        }
     }
 }
 
@@ -227,35 +286,6 @@ impl Scenario {
                     )))
                 }
             };
-            let need = |what: &str, v: &Option<String>| -> Result<(), LoadError> {
-                if v.is_none() {
-                    return Err(bad(format!("{which}: this kind needs `{what}`")));
-                }
-                Ok(())
-            };
-            match kind {
-                FaultKind::RobotMalfunction | FaultKind::HumanTooClose => {
-                    need("robot", &f.robot)?;
-                    if f.duration.is_none() {
-                        return Err(bad(format!("{which}: this kind needs `duration` (ticks)")));
-                    }
-                }
-                FaultKind::FaultyGripper => need("robot", &f.robot)?,
-                FaultKind::FaultyPart | FaultKind::InsufficientParts => need("part", &f.part)?,
-                FaultKind::FlippedPart => {
-                    if f.retract.as_ref().is_none_or(Vec::is_empty) || f.add.is_empty() {
-                        return Err(bad(format!(
-                            "{which}: say how the part lies flipped: `retract` and `add` facts"
-                        )));
-                    }
-                }
-                FaultKind::SensorBlackout => {
-                    if f.duration.is_none() {
-                        return Err(bad(format!("{which}: this kind needs `duration` (ticks)")));
-                    }
-                }
-                FaultKind::HighPriorityOrder => need("goal", &f.goal)?,
-            }
             let blackout = match f.conditions.as_deref() {
                 None | Some("running") => Blackout::Running,
                 Some("failure") => Blackout::Failure,
@@ -280,7 +310,7 @@ impl Scenario {
                 })?),
                 None => None,
             };
-            faults.push(FaultSpec {
+            let spec = FaultSpec {
                 kind,
                 name: f.name,
                 trigger,
@@ -291,7 +321,11 @@ impl Scenario {
                 add: atoms(&f.add)?,
                 goal,
                 blackout,
-            });
+            };
+            if let Some(m) = spec.missing() {
+                return Err(bad(format!("{which}: {m}")));
+            }
+            faults.push(spec);
         }
         Ok(())
     }
@@ -311,6 +345,32 @@ pub struct FaultRt {
     pub(crate) added: Vec<Key>,
     pub(crate) shown: Vec<String>,
     pub(crate) goal: Option<FormulaId>,
+}
+
+impl FaultRt {
+    /// A fault that happened outside btc's engine (an embedder's behaviour
+    /// reported it) at tick `met_at`, having removed and added these facts:
+    /// over, with nothing left to do but to be named by what it changed.
+    pub fn reported(
+        spec: FaultSpec,
+        met_at: u64,
+        removed: Vec<Key>,
+        added: Vec<Key>,
+        shown: Vec<String>,
+    ) -> FaultRt {
+        FaultRt {
+            spec,
+            met_at: Some(met_at),
+            until: None,
+            ended: true,
+            seen: 1,
+            pending_fail: false,
+            removed,
+            added,
+            shown,
+            goal: None,
+        }
+    }
 }
 
 /// How a fault ended, for the summary.

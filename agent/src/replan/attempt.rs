@@ -12,6 +12,55 @@ use btc_runtime::faults::FaultKind;
 use btc_runtime::{Kb, TreeDoc};
 use std::time::Instant;
 
+/// What planning and compiling an attempt made, before it runs.
+pub(super) struct Compiled {
+    pub attempt: usize,
+    pub source: &'static str,
+    pub goal_text: String,
+    pub plan: Vec<String>,
+    pub planning_ms: f64,
+    pub expanded: usize,
+    pub compile_ms: f64,
+    /// The attempt is for a priority order's goal, not the whole goal.
+    pub for_priority: bool,
+}
+
+/// How an attempt's run went, for its record.
+pub(super) struct RunPart {
+    pub run_ms: f64,
+    pub start_tick: u64,
+    pub end_tick: u64,
+    pub status: Status,
+    pub steps_done: usize,
+    pub steps_total: usize,
+    pub records: Vec<FaultRecord>,
+    pub waited_ticks: u64,
+    pub preempted: bool,
+}
+
+impl Compiled {
+    pub(super) fn record(self, r: RunPart) -> Attempt {
+        Attempt {
+            attempt: self.attempt,
+            source: self.source,
+            goal: self.goal_text,
+            plan: self.plan,
+            planning_ms: self.planning_ms,
+            expanded: self.expanded,
+            compile_ms: self.compile_ms,
+            run_ms: r.run_ms,
+            start_tick: r.start_tick,
+            end_tick: r.end_tick,
+            status: r.status,
+            steps_done: r.steps_done,
+            steps_total: r.steps_total,
+            records: r.records,
+            waited_ticks: r.waited_ticks,
+            preempted: r.preempted,
+        }
+    }
+}
+
 /// What an attempt's run ended in, for deciding what comes next.
 pub(super) struct Ran {
     pub status: Status,
@@ -53,7 +102,7 @@ impl Run<'_, '_> {
             self.db.set_file(&self.plan_path, text);
         }
         let tc = Instant::now();
-        let ir = db::compile(self.db, self.job).as_ref().map_err(|e| {
+        let ir = db::compile(self.db, self.job).clone().map_err(|e| {
             let mut e = e.clone();
             if e.is_empty() {
                 e = db::job_diagnostics(self.db, self.job)
@@ -64,7 +113,6 @@ impl Run<'_, '_> {
             }
             LoopError::Compile(e)
         })?;
-        let doc = TreeDoc::from_ir(ir);
         let compile_ms = tc.elapsed().as_secs_f64() * 1e3;
         let plan: Vec<String> = ir.steps.iter().map(|s| s.display()).collect();
         let goal_text = goal.to_string();
@@ -78,15 +126,39 @@ impl Run<'_, '_> {
                 }),
             );
         }
+        let compiled = Compiled {
+            attempt,
+            source,
+            goal_text,
+            plan,
+            planning_ms,
+            expanded,
+            compile_ms,
+            for_priority,
+        };
+        if self.execution.is_outside() {
+            self.run_outside(compiled, goal, &ir)
+        } else {
+            self.run_in_engine(compiled, goal, &TreeDoc::from_ir(&ir))
+        }
+    }
+
+    /// Runs the attempt's tree in btc's engine, in the carried world, with
+    /// the scenario's faults and the embedder's installed leaves.
+    fn run_in_engine(
+        &mut self,
+        c: Compiled,
+        goal: &Formula,
+        doc: &TreeDoc,
+    ) -> Result<Ran, LoopError> {
+        let trace = self.opts.engine.trace;
         // Run, in the carried world.
         let mut kb = self.carry.kb(&self.world);
         let g = goal_formula(&mut kb, goal)?;
         kb.set_goal(g);
         let mut engine =
-            Engine::build(&doc, Some(kb), self.opts.engine.clone()).map_err(LoopError::Tree)?;
-        if let Some(install) = self.leaves.as_mut() {
-            install(&mut engine);
-        }
+            Engine::build(doc, Some(kb), self.opts.engine.clone()).map_err(LoopError::Tree)?;
+        self.execution.install(&mut engine);
         engine.tick = self.carry.tick;
         match self.carry.faults.take() {
             Some(f) => engine.restore_faults(f),
@@ -145,16 +217,9 @@ impl Run<'_, '_> {
         self.carry.tick = engine.tick;
         self.carry.faults = Some(engine.take_faults());
         self.out.ticks = self.carry.tick;
-        self.out.goal_reached = goal_ok && done && !for_priority;
+        self.out.goal_reached = goal_ok && done && !c.for_priority;
         self.out.goal_failure = goal_why;
-        self.out.attempts.push(Attempt {
-            attempt,
-            source,
-            goal: goal_text,
-            plan,
-            planning_ms,
-            expanded,
-            compile_ms,
+        self.out.attempts.push(c.record(RunPart {
             run_ms,
             start_tick,
             end_tick,
@@ -164,7 +229,7 @@ impl Run<'_, '_> {
             records: sum.records.clone(),
             waited_ticks: waited,
             preempted,
-        });
+        }));
         Ok(Ran {
             status,
             done,

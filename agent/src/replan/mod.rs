@@ -14,7 +14,11 @@
 mod after;
 mod attempt;
 mod carry;
+mod external;
 mod planning;
+
+use external::Execution;
+pub use external::{Executed, Executor, Handoff};
 
 use btc_lang::db::{self, CompileJob, Database, JobWorld};
 use btc_lang::path::FilePath;
@@ -196,6 +200,35 @@ pub fn run_loop_with(
     trace_out: &mut dyn std::io::Write,
     leaves: Option<InstallLeaves<'_, '_>>,
 ) -> Result<LoopSummary, LoopError> {
+    let execution = Execution::Engine(leaves);
+    run_loop_on(db, job, given_plan, scenario, opts, trace_out, execution)
+}
+
+/// The loop with every attempt's tree run by `executor` instead of btc's
+/// engine (a py_trees or BehaviorTree.CPP tree with the embedder's
+/// behaviours): the planning, the faults' effects and the replanning are
+/// the loop's, as for `btc run --replan`. There is no scenario: faults are
+/// what the executor reports.
+pub fn run_loop_outside(
+    db: &mut Database,
+    job: CompileJob,
+    opts: &LoopOptions,
+    executor: &mut dyn Executor,
+) -> Result<LoopSummary, LoopError> {
+    let execution = Execution::Outside(executor);
+    let sink = &mut std::io::sink();
+    run_loop_on(db, job, false, None, opts, sink, execution)
+}
+
+fn run_loop_on(
+    db: &mut Database,
+    job: CompileJob,
+    given_plan: bool,
+    scenario: Option<&Scenario>,
+    opts: &LoopOptions,
+    trace_out: &mut dyn std::io::Write,
+    execution: Execution<'_, '_>,
+) -> Result<LoopSummary, LoopError> {
     let t0 = Instant::now();
     let goal_span = world(db, job)?.problem.goal.as_ref().map_or(
         Span::new(problem_file_id(db, job), 0, 0),
@@ -218,7 +251,7 @@ pub fn run_loop_with(
         scenario,
         opts,
         trace_out,
-        leaves,
+        execution,
         out: LoopSummary::new(base_goal.to_string()),
         world: the_world,
         base_goal,
@@ -250,7 +283,7 @@ struct Run<'a, 'l> {
     scenario: Option<&'a Scenario>,
     opts: &'a LoopOptions,
     trace_out: &'a mut dyn std::io::Write,
-    leaves: Option<InstallLeaves<'a, 'l>>,
+    execution: Execution<'a, 'l>,
     world: World,
     /// The problem's goal, before any adjustment.
     base_goal: Formula,

@@ -189,11 +189,44 @@ impl World {
     pub fn atom_of(&self, k: &[u32]) -> Atom {
         Atom {
             pred: self.model.predicates[k[0] as usize].name.clone(),
-            args: k[1..]
-                .iter()
-                .map(|&o| crate::logic::Term::Obj(self.model.objects[o as usize].name.clone()))
-                .collect(),
+            args: self.args_of(k),
         }
+    }
+
+    /// A fluent's ground term for its key (the inverse of
+    /// [`World::fluent_key`]).
+    pub fn fluent_of(&self, k: &[u32]) -> Atom {
+        Atom {
+            pred: self.model.functions[k[0] as usize].name.clone(),
+            args: self.args_of(k),
+        }
+    }
+
+    fn args_of(&self, k: &[u32]) -> Vec<crate::logic::Term> {
+        k[1..]
+            .iter()
+            .map(|&o| crate::logic::Term::Obj(self.model.objects[o as usize].name.clone()))
+            .collect()
+    }
+
+    /// A state as `:init` facts: its true facts, then its fluents' values
+    /// (derived atoms are not facts: they follow from the others), each
+    /// group sorted.
+    pub fn init_of(&self, s: &State) -> Vec<crate::logic::InitFact> {
+        use crate::logic::InitFact;
+        let mut facts: Vec<&Key> = s.facts.iter().collect();
+        facts.sort();
+        let mut values: Vec<(&Key, &f64)> = s.fluents.iter().collect();
+        values.sort_by(|a, b| a.0.cmp(b.0));
+        facts
+            .into_iter()
+            .map(|k| InitFact::Atom(self.atom_of(k)))
+            .chain(
+                values
+                    .into_iter()
+                    .map(|(k, v)| InitFact::Value(self.fluent_of(k), *v)),
+            )
+            .collect()
     }
 
     /// Applies changes: deletes first, then adds (an atom both deleted and

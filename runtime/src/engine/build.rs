@@ -120,7 +120,7 @@ impl<'w> Engine<'w> {
     fn load_steps(&mut self, doc: &TreeDoc) -> Result<(), LoadError> {
         for s in &doc.steps {
             let mut rt = StepRt {
-                label: format!("step {}: {}", s.index + 1, s.display()),
+                label: s.label(),
                 skipped: s.skipped,
                 ..StepRt::default()
             };

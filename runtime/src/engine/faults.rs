@@ -10,7 +10,6 @@ use super::{Engine, Status, TraceItem};
 use crate::error::LoadError;
 use crate::faults::{bad, Blackout, FaultKind, FaultOutcome, FaultRt, Scenario, Trigger};
 use btc_pddl::logic::Atom;
-use btc_pddl::state::Key;
 
 impl<'w> Engine<'w> {
     /// Arms a scenario's faults; their facts and goals are checked against
@@ -95,33 +94,7 @@ impl<'w> Engine<'w> {
         }
         // KB changes.
         if let Some(kb) = self.kb.as_mut() {
-            let mut retract: Vec<Key> = Vec::new();
-            match &spec.retract {
-                Some(list) => {
-                    for t in list {
-                        if let Ok(k) = kb.atom_key(t) {
-                            retract.push(k);
-                        }
-                    }
-                }
-                None if matches!(
-                    spec.kind,
-                    FaultKind::FaultyPart | FaultKind::InsufficientParts
-                ) =>
-                {
-                    if let Some(o) = spec.part.as_deref().and_then(|p| kb.object(p)) {
-                        retract = kb.facts_mentioning(o);
-                    }
-                }
-                None => {}
-            }
-            retract.retain(|k| kb.state.facts.contains(k));
-            let mut add: Vec<Key> = spec
-                .add
-                .iter()
-                .filter_map(|t| kb.atom_key(t).ok())
-                .collect();
-            add.retain(|k| !kb.state.facts.contains(k));
+            let (add, retract) = spec.changes(kb);
             let shown: Vec<String> = retract.iter().chain(&add).map(|k| kb.show(k)).collect();
             kb.apply_keys(add.clone(), retract.clone());
             if let Some(g) = self.faults[f].goal {

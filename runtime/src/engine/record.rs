@@ -35,6 +35,12 @@ pub struct FaultRecord {
     pub kb: Vec<String>,
 }
 
+impl FaultRecord {
+    /// The `node` of a record an executor outside btc's engine made (a
+    /// py_trees or BehaviorTree.CPP tree): it names its node by id and name.
+    pub const OUTSIDE_ENGINE: u32 = u32::MAX;
+}
+
 impl<'w> Engine<'w> {
     pub(crate) fn note_failure(&mut self, node: u32, r: Reason) {
         self.last_failure = Some((node, r));
