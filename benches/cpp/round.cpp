@@ -137,7 +137,7 @@ int main(int argc, char** argv)
           " --problem " + dir + "/problem.pddl --emit btcpp -o " + work + "/tree.xml && " + exe +
           " compile " + dir + "/rules.btrules --plan " + plan + " --problem " + dir +
           "/problem.pddl --emit kb -o " + work + "/world.kb";
-      if(std::system((run + " >/dev/null 2>&1").c_str()) != 0)
+      if(std::system(("(" + run + ") >/dev/null 2>&1").c_str()) != 0)
       {
         throw std::runtime_error("the subprocess route failed: " + run);
       }

@@ -127,24 +127,30 @@ void btc_tree_free(btc_tree *tree);
 /* The executor of an agent: runs one attempt's tree and answers with
  * btc_reply_set(). `attempt_json` (valid during the call) is
  *   {"attempt": 1, "tree_xml": "<root ...>", "nodes": [as btc_tree_nodes],
+ *    "steps": ["(move r1 a b)", ...],
  *    "state": ["(at r1 a)", "(= (battery r1) 20.0)"], "goal": "(and ...)",
- *    "tick": 0, "steps": ["(move r1 a b)", ...]}
- * (`state`: the facts the attempt starts from; `tick`: ticks run before).
- * Return 0 with the outcome as the reply:
+ *    "tick": 0, "max_ticks": 100000}
+ * (`state`: the facts the attempt starts from, which replace the problem's
+ * initial state; `tick`: the loop's tick; `max_ticks`: the most ticks the
+ * attempt may run). Return 0 with the outcome as the reply:
  *   {"status": "success" | "failure" | "running",
- *    "state": [facts after the run], "ticks": 12, "steps_done": 2,
+ *    "state": [facts and values after the run], "ticks": 12,
+ *    "steps_done": 2,
  *    "records": [{"node_id": "MoveTo", "node_name": "move", "reason": "...",
- *                 "step": 3 or null}],
- *    "faults": [{"kind": "faulty_gripper", "part": null, "robot": "r1",
- *                "goal": null, "retract": ["(attach p r1)"],
- *                "add": ["(on p bin1)"], "reason": "..." or null}]}
- * (`kind`: one of ARIAC's faulty_part, faulty_gripper, robot_malfunction,
- * flipped_part, sensor_blackout, high_priority_order, insufficient_parts,
- * human_too_close; btc applies `retract` and `add` to the state it replans
- * from and adjusts the goal as `btc run --replan` does). Return nonzero
- * when the attempt could not be executed, with the reason as the reply
- * text: the loop stops with that error (A003). The callback must not
- * unwind (no C++ exception may leave it). */
+ *                 "step": 3 or null, "tick": 9, "faults": ["faulty_gripper"]}],
+ *    "faults": [{"kind": "faulty_gripper", "name": null, "robot": "r1",
+ *                "part": null, "duration": null, "goal": null,
+ *                "retract": ["(attach p r1)"], "add": ["(on p bin1)"],
+ *                "tick": 9}]}
+ * (records: why nodes failed, the last one the failure the loop replans
+ * after; `tick`s count from the attempt's start; a fault's `kind` is one of
+ * ARIAC's faulty_part, faulty_gripper, robot_malfunction, flipped_part,
+ * sensor_blackout, high_priority_order, insufficient_parts,
+ * human_too_close, and it changes the KB as the same fault of a scenario
+ * file does, docs/runtime.md). Return nonzero when the attempt could not be
+ * executed, with the reason as the reply text: the loop stops with that
+ * error (X005), as it does for an answer it cannot read. The callback must
+ * not unwind (no C++ exception may leave it). */
 typedef int (*btc_execute_fn)(void *user, const char *attempt_json,
                               btc_reply *reply);
 

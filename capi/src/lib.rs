@@ -11,6 +11,7 @@
 // checked (null, kind) before use.
 #![allow(clippy::missing_safety_doc)]
 
+mod agent;
 mod boundary;
 mod handle;
 
@@ -19,6 +20,11 @@ use btc_api::{Error, Plan, Project, Target, Tree};
 use handle::Handle;
 use std::ffi::{c_char, CStr};
 use std::path::Path;
+
+pub use agent::{
+    btc_agent, btc_agent_free, btc_agent_new, btc_agent_run, btc_execute_fn, btc_reply,
+    btc_reply_set,
+};
 
 /// A project: a rules file and what it names, loaded once.
 #[repr(C)]

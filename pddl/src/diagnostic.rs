@@ -370,7 +370,6 @@ pub mod codes {
         // Embedding: btc's C API (btc-capi, the C++ library over it)
         A_ARGUMENT = "A001", "a null pointer, a text that is not UTF-8 or a handle of another kind given to btc's C API";
         A_INTERNAL = "A002", "a failure inside btc that its C API caught instead of crashing the host (a bug in btc)";
-        A_EXECUTOR = "A003", "an executor's answer to the agent that is missing or cannot be read";
         // ARIAC trials (btc trial)
         TRIAL_SYNTAX = "T001", "a trial file that is not YAML btc reads";
         TRIAL_MISSING = "T002", "a trial field the ARIAC 2023 format requires is missing";

@@ -20,7 +20,9 @@ using nlohmann::json;
 class FailureObserver : public BT::StatusChangeLogger
 {
 public:
-  FailureObserver(BT::TreeNode* root, Kb& kb) : BT::StatusChangeLogger(root), kb_(kb) {}
+  FailureObserver(BT::TreeNode* root, Kb& kb, const long& tick)
+    : BT::StatusChangeLogger(root), kb_(kb), tick_(tick)
+  {}
 
   void callback(BT::Duration, const BT::TreeNode& node, BT::NodeStatus,
                 BT::NodeStatus status) override
@@ -36,6 +38,7 @@ public:
     r.node_name = node.name();
     r.step = kb_.currentStep();
     r.reason = kb_.lastFailureWhy();
+    r.tick = tick_;
     last = std::move(r);
   }
   void flush() override {}
@@ -44,6 +47,7 @@ public:
 
 private:
   Kb& kb_;
+  const long& tick_;
 };
 
 PortType portType(const std::string& t)
@@ -76,9 +80,15 @@ std::vector<PortSpec> portSpecs(const NodeInfo& n)
 json faultJson(const ReportedFault& f)
 {
   auto opt = [](const std::optional<std::string>& s) { return s ? json(*s) : json(nullptr); };
-  return json{ { "kind", f.kind },       { "part", opt(f.part) }, { "robot", opt(f.robot) },
-               { "goal", opt(f.goal) },  { "retract", f.retract }, { "add", f.add },
-               { "reason", f.reason.empty() ? json(nullptr) : json(f.reason) } };
+  return json{ { "kind", f.kind },
+               { "name", f.name.empty() ? json(nullptr) : json(f.name) },
+               { "part", opt(f.part) },
+               { "robot", opt(f.robot) },
+               { "duration", f.duration ? json(*f.duration) : json(nullptr) },
+               { "goal", opt(f.goal) },
+               { "retract", f.retract },
+               { "add", f.add },
+               { "tick", f.tick } };
 }
 
 json resultJson(const AttemptResult& r)
@@ -89,7 +99,9 @@ json resultJson(const AttemptResult& r)
     records.push_back(json{ { "node_id", rec.node_id },
                             { "node_name", rec.node_name },
                             { "reason", rec.reason },
-                            { "step", rec.step > 0 ? json(rec.step) : json(nullptr) } });
+                            { "step", rec.step > 0 ? json(rec.step) : json(nullptr) },
+                            { "tick", rec.tick },
+                            { "faults", rec.faults } });
   }
   json faults = json::array();
   for(const auto& f : r.faults)
@@ -116,13 +128,13 @@ AttemptInput attemptFromJson(const json& j)
   a.state = j.at("state").get<std::vector<std::string>>();
   a.goal = j.value("goal", "");
   a.tick = j.value("tick", 0L);
+  a.max_ticks = j.value("max_ticks", 0L);
   return a;
 }
 
 struct Call
 {
   Agent* agent;
-  long max_ticks;
 };
 
 /// The C callback btc calls for each attempt. No exception crosses the C
@@ -133,8 +145,7 @@ extern "C" int executeTrampoline(void* user, const char* attempt_json, btc_reply
   try
   {
     const auto attempt = attemptFromJson(json::parse(attempt_json));
-    const long left = std::max(0L, call->max_ticks - attempt.tick);
-    const AttemptResult r = call->agent->execute(attempt, left);
+    const AttemptResult r = call->agent->execute(attempt, attempt.max_ticks);
     btc_reply_set(reply, resultJson(r).dump().c_str());
     return 0;
   }
@@ -222,11 +233,17 @@ AttemptResult Agent::execute(const AttemptInput& attempt, long max_ticks)
   try
   {
     auto tree = factory_.createTreeFromText(attempt.tree_xml);
-    FailureObserver observer(tree.rootNode(), kb_);
+    FailureObserver observer(tree.rootNode(), kb_, tick);
     while(tick < max_ticks)
     {
       ++tick;
       status = tree.tickExactlyOnce();
+      // Faults reported during this tick happened at it.
+      for(auto& f : kb_.takeFaults())
+      {
+        f.tick = tick;
+        result.faults.push_back(std::move(f));
+      }
       if(status != BT::NodeStatus::RUNNING)
       {
         break;
@@ -250,7 +267,6 @@ AttemptResult Agent::execute(const AttemptInput& attempt, long max_ticks)
   result.status = status;
   result.ticks = tick;
   result.state = kb_.snapshot();
-  result.faults = kb_.takeFaults();
   for(int s = 1; s <= kb_.stepCount(); ++s)
   {
     const Step* step = kb_.step(s);
@@ -259,9 +275,17 @@ AttemptResult Agent::execute(const AttemptInput& attempt, long max_ticks)
   if(status == BT::NodeStatus::FAILURE && failed_leaf)
   {
     FaultRecord r = *failed_leaf;
-    if(!result.faults.empty() && !result.faults.back().reason.empty())
+    // A fault reported at the failing tick is what the failure is due to.
+    for(const auto& f : result.faults)
     {
-      r.reason = result.faults.back().reason;
+      if(f.tick == r.tick)
+      {
+        r.faults.push_back(f.name.empty() ? f.kind : f.name);
+        if(!f.reason.empty())
+        {
+          r.reason = f.reason;
+        }
+      }
     }
     result.records.push_back(std::move(r));
   }
@@ -276,7 +300,7 @@ AgentReport Agent::run(const AgentOptions& options)
 {
   kb_.ticks_per_action = options.ticks_per_action;
   const json opts{ { "max_replans", options.max_replans }, { "max_ticks", options.max_ticks } };
-  Call call{ this, options.max_ticks };
+  Call call{ this };
   char* error = nullptr;
   const std::string text = capi::text(
       btc_agent_run(agent_, opts.dump().c_str(), executeTrampoline, &call, &error), error);

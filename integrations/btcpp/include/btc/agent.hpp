@@ -36,6 +36,9 @@ struct FaultRecord
   std::string node_name;
   int step = 0;
   std::string reason;
+  long tick = 0;  ///< of the attempt
+  /// The reported faults the failure is due to (their labels).
+  std::vector<std::string> faults;
 };
 
 /// A step starting or finishing at a tick of one attempt.
@@ -55,6 +58,7 @@ struct AttemptInput
   std::vector<std::string> state;  ///< the facts the attempt starts from
   std::string goal;
   long tick = 0;  ///< ticks run before this attempt
+  long max_ticks = 0;  ///< the most ticks the attempt may run
 };
 
 /// What an attempt came to, as the executor reports it to btc.

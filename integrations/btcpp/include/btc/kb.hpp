@@ -86,6 +86,12 @@ struct ReportedFault
   std::vector<std::string> add;
   /// What the node saw, in words (the fault record's reason).
   std::string reason;
+  /// Its label in btc's report (empty: the kind).
+  std::string name;
+  /// How long it lasts, in ticks (a malfunction, a blackout, a human).
+  std::optional<long> duration;
+  /// The tick of the attempt it happened at (the agent sets it).
+  long tick = 0;
 };
 
 /// The knowledge base: shared by every node of a tree (`registerKbNodes`
