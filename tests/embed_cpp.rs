@@ -3,15 +3,18 @@
 //! compared with `btc run --replan --format json` on the same scenarios:
 //! each scenario fault that a node can report (one triggered by an action
 //! node, `on_action`) is injected into the example's simulated action
-//! server, whose node then reports it to btc. The attempts' plans, the
-//! steps each attempt started (in order), the faults, the replans, the
-//! goal verdict and the final KB must be the same. The example's node
+//! server, whose node then reports it to btc. The attempts' plans and
+//! statuses, the steps each attempt started (in order), the faults, the
+//! replans and the goal verdict must be those of `btc run --replan`, and
+//! the final KB that of the same loop with btc's engine executing. The example's node
 //! stands in for a ROS 2 action client (goal, polls over ticks, cancel on
 //! halt), so tick counts differ by design and are not compared.
 //!
 //! Skipped without BT.CPP locally, required under `CI=true`.
 
 mod support;
+#[path = "support/engine.rs"]
+mod engine;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use support::{btc, json_of};
@@ -196,7 +199,7 @@ fn the_cpp_agent_recovers_as_btc_run_replan_does() {
             replans: cli["replans"].as_array().unwrap().len(),
             goal: cli["goal"].as_str().unwrap().to_owned(),
             goal_reached: cli["goal_reached"].as_bool().unwrap(),
-            kb: cli_kb(&cli),
+            kb: engine_kb(&rules, &scenario),
         };
         assert_eq!(
             ours, theirs,
@@ -242,7 +245,16 @@ fn cli_started(rules: &Path, ariac: &Path, scenario: &Path) -> Vec<Vec<u64>> {
     attempts
 }
 
-/// The final KB of `btc run --replan --format json`.
-fn cli_kb(cli: &serde_json::Value) -> Vec<String> {
-    strings(&cli["kb"])
+/// The final KB of the same loop with btc's engine as the executor (the
+/// engine `btc run --replan` runs; `btc run` does not print the final KB
+/// of a closed loop).
+fn engine_kb(rules: &Path, scenario: &Path) -> Vec<String> {
+    let project = btc_api::Project::open(rules).unwrap();
+    let mut agent = btc_api::Agent::new(project, None);
+    let mut engine = engine::ReportingEngine::new(btc_api::Faults::open(scenario).unwrap());
+    let report = agent
+        .run_with(&btc_api::AgentOptions::default(), &mut engine)
+        .unwrap();
+    assert!(report.goal_reached);
+    engine.kb
 }
