@@ -5,18 +5,18 @@
 //! Then bad input through the API: an error value with diagnostics, never
 //! a panic.
 
-mod support;
 #[path = "support/engine.rs"]
 mod engine;
+mod support;
 use btc_api::{
-    Agent, AgentOptions, AttemptInput, Executed, Executor, Faults, Plan, Project,
-    RunOptions, Status, Target,
+    Agent, AgentOptions, AttemptInput, Executed, Executor, Faults, Plan, Project, RunOptions,
+    Status, Target,
 };
+use engine::ReportingEngine;
 use serde_json::Value;
 use std::cell::Cell;
 use std::path::Path;
 use std::rc::Rc;
-use engine::ReportingEngine;
 use support::{btc, exits, json_of};
 
 const EXAMPLES: &[(&str, &str)] = &[

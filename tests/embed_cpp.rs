@@ -12,9 +12,9 @@
 //!
 //! Skipped without BT.CPP locally, required under `CI=true`.
 
-mod support;
 #[path = "support/engine.rs"]
 mod engine;
+mod support;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use support::{btc, json_of};
@@ -126,81 +126,9 @@ fn the_cpp_agent_recovers_as_btc_run_replan_does() {
             String::from_utf8_lossy(&out.stderr)
         );
         let cpp = json_of(&out);
-        let cli = json_of(&btc(&[
-            "run",
-            rules.to_str().unwrap(),
-            "--problem",
-            ariac.join("problem.pddl").to_str().unwrap(),
-            "--replan",
-            "--faults",
-            scenario.to_str().unwrap(),
-            "--format",
-            "json",
-        ]));
-        let report = &cpp["report"];
-        let ours = Outcome {
-            plans: report["attempts"]
-                .as_array()
-                .unwrap()
-                .iter()
-                .map(|a| strings(&a["plan"]))
-                .collect(),
-            started: cpp["attempts"]
-                .as_array()
-                .unwrap()
-                .iter()
-                .map(|a| {
-                    a["steps"]
-                        .as_array()
-                        .unwrap()
-                        .iter()
-                        .filter(|s| s["started"] == true)
-                        .map(|s| s["step"].as_u64().unwrap())
-                        .collect()
-                })
-                .collect(),
-            statuses: report["attempts"]
-                .as_array()
-                .unwrap()
-                .iter()
-                .map(|a| a["status"].as_str().unwrap().to_ascii_uppercase())
-                .collect(),
-            faults: report["faults"]
-                .as_array()
-                .unwrap()
-                .iter()
-                .map(|f| f["kind"].as_str().unwrap().to_owned())
-                .collect(),
-            replans: report["replans"].as_array().unwrap().len(),
-            goal: report["goal"].as_str().unwrap().to_owned(),
-            goal_reached: report["goal_reached"].as_bool().unwrap(),
-            kb: strings(&cpp["kb"]),
-        };
-        let theirs = Outcome {
-            plans: cli["attempts"]
-                .as_array()
-                .unwrap()
-                .iter()
-                .map(|a| strings(&a["plan"]))
-                .collect(),
-            started: cli_started(&rules, &ariac, &scenario),
-            statuses: cli["attempts"]
-                .as_array()
-                .unwrap()
-                .iter()
-                .map(|a| a["status"].as_str().unwrap().to_owned())
-                .collect(),
-            faults: cli["faults"]
-                .as_array()
-                .unwrap()
-                .iter()
-                .map(|f| f["kind"].as_str().unwrap().to_owned())
-                .collect(),
-            replans: cli["replans"].as_array().unwrap().len(),
-            goal: cli["goal"].as_str().unwrap().to_owned(),
-            goal_reached: cli["goal_reached"].as_bool().unwrap(),
-            kb: engine_kb(&rules, &scenario),
-        };
+        let ours = outcome(&cpp["report"], cpp_started(&cpp), strings(&cpp["kb"]));
+        let (cli, started) = cli_run(&rules, &ariac, &scenario);
+        let theirs = outcome(&cli, started, engine_kb(&rules, &scenario));
         assert_eq!(
             ours, theirs,
             "{name}: the C++ agent against btc run --replan"
@@ -211,9 +139,53 @@ fn the_cpp_agent_recovers_as_btc_run_replan_does() {
     assert!(compared >= 2, "only {compared} scenarios compared");
 }
 
-/// The steps each attempt of `btc run --replan` started, in order, from
-/// its trace (1-based, as the KB numbers them).
-fn cli_started(rules: &Path, ariac: &Path, scenario: &Path) -> Vec<Vec<u64>> {
+/// The outcome a loop's report (btc-api's or `btc run --replan`'s JSON)
+/// gives, with the steps each attempt started and the final KB.
+fn outcome(report: &serde_json::Value, started: Vec<Vec<u64>>, kb: Vec<String>) -> Outcome {
+    let list = |key: &str| report[key].as_array().unwrap().clone();
+    Outcome {
+        plans: list("attempts")
+            .iter()
+            .map(|a| strings(&a["plan"]))
+            .collect(),
+        started,
+        statuses: list("attempts")
+            .iter()
+            .map(|a| a["status"].as_str().unwrap().to_ascii_uppercase())
+            .collect(),
+        faults: list("faults")
+            .iter()
+            .map(|f| f["kind"].as_str().unwrap().to_owned())
+            .collect(),
+        replans: list("replans").len(),
+        goal: report["goal"].as_str().unwrap().to_owned(),
+        goal_reached: report["goal_reached"].as_bool().unwrap(),
+        kb,
+    }
+}
+
+/// The steps each attempt of the C++ agent started, in order.
+fn cpp_started(cpp: &serde_json::Value) -> Vec<Vec<u64>> {
+    cpp["attempts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|a| {
+            a["steps"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .filter(|s| s["started"] == true)
+                .map(|s| s["step"].as_u64().unwrap())
+                .collect()
+        })
+        .collect()
+}
+
+/// `btc run --replan --format json` on a scenario, and the steps each
+/// attempt started, in order, from its trace (1-based, as the KB numbers
+/// them).
+fn cli_run(rules: &Path, ariac: &Path, scenario: &Path) -> (serde_json::Value, Vec<Vec<u64>>) {
     let dir = tempfile::tempdir().unwrap();
     let trace = dir.path().join("trace.jsonl");
     let out = btc(&[
@@ -224,10 +196,12 @@ fn cli_started(rules: &Path, ariac: &Path, scenario: &Path) -> Vec<Vec<u64>> {
         "--replan",
         "--faults",
         scenario.to_str().unwrap(),
+        "--format",
+        "json",
         "--trace",
         trace.to_str().unwrap(),
     ]);
-    assert!(out.status.code().is_some(), "btc run --trace");
+    let report = json_of(&out);
     let text = std::fs::read_to_string(&trace).unwrap();
     let mut attempts: Vec<Vec<u64>> = Vec::new();
     for line in text.lines() {
@@ -242,7 +216,7 @@ fn cli_started(rules: &Path, ariac: &Path, scenario: &Path) -> Vec<Vec<u64>> {
                 .push(e["step"].as_u64().unwrap());
         }
     }
-    attempts
+    (report, attempts)
 }
 
 /// The final KB of the same loop with btc's engine as the executor (the

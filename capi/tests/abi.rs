@@ -174,3 +174,95 @@ fn bad_pointers_are_refused_not_followed() {
         );
     }
 }
+
+/// An executor that answers with the text in `user` and the code it holds.
+unsafe extern "C" fn answer(
+    user: *mut std::ffi::c_void,
+    attempt: *const c_char,
+    reply: *mut btc_reply,
+) -> std::ffi::c_int {
+    let (code, text) = &*(user as *const (i32, CString));
+    let attempt: serde_json::Value =
+        serde_json::from_str(CStr::from_ptr(attempt).to_str().unwrap()).unwrap();
+    assert!(attempt["tree_xml"].as_str().unwrap().contains("KbStep"));
+    assert!(!attempt["state"].as_array().unwrap().is_empty());
+    btc_reply_set(reply, text.as_ptr());
+    *code
+}
+
+unsafe fn agent() -> *mut btc_agent {
+    let rules = example("ariac/rules.btrules");
+    let path = c(rules.to_str().unwrap());
+    let mut err = null_mut();
+    let project = btc_project_open(path.as_ptr(), &mut err);
+    let agent = btc_agent_new(project, std::ptr::null(), &mut err);
+    assert!(!agent.is_null() && err.is_null());
+    agent
+}
+
+#[test]
+fn the_agent_runs_the_hosts_executor_and_refuses_what_it_cannot_read() {
+    unsafe {
+        let mut err = null_mut();
+        // The executor did the whole plan: the goal is reached.
+        let done = (
+            0,
+            c(
+                r#"{"status": "success", "state": ["(on battery_red agv1)", "(is_enabled floor_robot)"],
+                  "ticks": 4, "steps_done": 4}"#,
+            ),
+        );
+        let a = agent();
+        let report = btc_agent_run(
+            a,
+            c(r#"{"max_replans": 2}"#).as_ptr(),
+            Some(answer),
+            &done as *const _ as *mut _,
+            &mut err,
+        );
+        assert!(!report.is_null(), "{}", take(err));
+        let report: serde_json::Value = serde_json::from_str(&take(report)).unwrap();
+        assert_eq!(report["goal_reached"], true, "{report}");
+        assert_eq!(report["attempts"].as_array().unwrap().len(), 1);
+        // An executor that fails, or answers what is not an outcome: an
+        // error with diagnostics, the host goes on.
+        for (code, text, says) in [
+            (
+                1,
+                "the action server went away",
+                "the action server went away",
+            ),
+            (0, "{\"status\": \"flying\"}", "not an attempt's outcome"),
+            (0, "not json", "not an attempt's outcome"),
+            (
+                0,
+                r#"{"status": "failure", "state": ["(on battery_red the_moon)"]}"#,
+                "the_moon",
+            ),
+        ] {
+            let user = (code, c(text));
+            let r = btc_agent_run(
+                a,
+                std::ptr::null(),
+                Some(answer),
+                &user as *const _ as *mut _,
+                &mut err,
+            );
+            assert!(r.is_null());
+            let e = take(err);
+            assert!(e.contains(says), "{text}: {e}");
+        }
+        // No executor, bad options, a handle of another kind.
+        assert!(btc_agent_run(a, std::ptr::null(), None, null_mut(), &mut err).is_null());
+        assert_eq!(codes(err), ["A001"]);
+        let bad = c("{\"max_replan\": 1}");
+        assert!(btc_agent_run(a, bad.as_ptr(), Some(answer), null_mut(), &mut err).is_null());
+        assert_eq!(codes(err), ["A001"]);
+        let text = c("(move a b)\n");
+        let plan = btc_plan_parse(text.as_ptr(), &mut err);
+        assert!(btc_agent_new(plan.cast(), std::ptr::null(), &mut err).is_null());
+        assert_eq!(codes(err), ["A001"]);
+        btc_plan_free(plan);
+        btc_agent_free(a);
+    }
+}
