@@ -222,7 +222,10 @@ AttemptResult Agent::execute(const AttemptInput& attempt, long max_ticks)
   registerMissing(attempt.nodes);
   kb_.resetSteps();
   kb_.setState(attempt.state);
-  kb_.setGoal(attempt.goal);
+  if(!attempt.goal.empty())
+  {
+    kb_.setGoal(attempt.goal);
+  }
   kb_.takeFaults();
   AttemptResult result;
   long tick = 0;
