@@ -5,11 +5,14 @@
 //! Then bad input through the API: an error value with diagnostics, never
 //! a panic.
 
+#[path = "support/engine.rs"]
+mod engine;
 mod support;
 use btc_api::{
-    Agent, AgentOptions, AttemptInput, Executed, Executor, Faults, Plan, Project, Record,
-    RunOptions, Status, Target,
+    Agent, AgentOptions, AttemptInput, Executed, Executor, Faults, Plan, Project, RunOptions,
+    Status, Target,
 };
+use engine::ReportingEngine;
 use serde_json::Value;
 use std::cell::Cell;
 use std::path::Path;
@@ -205,55 +208,6 @@ fn the_agent_decides_as_btc_run_replan_on_every_ariac_fault() {
     }
 }
 
-/// An executor outside the loop that runs each attempt in btc's engine, the
-/// first with a scenario's faults, and reports the faults that happened as
-/// a behaviour would: the loop then knows of them only from the report.
-struct ReportingEngine {
-    faults: Option<Faults>,
-}
-
-impl Executor for ReportingEngine {
-    fn execute(&mut self, a: &AttemptInput) -> Result<Executed, String> {
-        let faults = self.faults.take();
-        let options = RunOptions {
-            max_ticks: a.max_ticks,
-            ..RunOptions::default()
-        };
-        let r = a
-            .tree
-            .run(&options, Vec::new(), faults.as_ref())
-            .map_err(|e| e.to_string())?;
-        let reported = faults
-            .iter()
-            .flat_map(Faults::reported)
-            .filter_map(|(label, mut f)| {
-                let met = r.faults.iter().find(|o| o.fault == label)?;
-                f.tick = met.met_at?;
-                Some(f)
-            })
-            .collect();
-        Ok(Executed {
-            status: r.status,
-            state: r.kb,
-            ticks: r.ticks,
-            steps_done: r.steps_done,
-            records: r
-                .records
-                .iter()
-                .map(|x| Record {
-                    node_id: x.node_id.clone(),
-                    node_name: x.node_name.clone(),
-                    reason: x.reason.clone(),
-                    step: x.step,
-                    tick: x.tick,
-                    faults: x.faults.clone(),
-                })
-                .collect(),
-            faults: reported,
-        })
-    }
-}
-
 /// Every scenario but `priority_order`: there, `btc run --replan` halts
 /// the tree the tick the order comes (the order preempts the plan), while
 /// `Tree::run`, this executor's engine, runs its tree to the end; an
@@ -276,9 +230,7 @@ fn an_executor_outside_the_engine_gets_the_replans_btc_run_replan_makes() {
     for s in REPORTED {
         let faults = Faults::open(root.join(format!("examples/ariac/faults/{s}.toml"))).unwrap();
         let mut agent = Agent::new(open("ariac"), None);
-        let mut executor = ReportingEngine {
-            faults: Some(faults),
-        };
+        let mut executor = ReportingEngine::new(faults);
         let ours = agent
             .run_with(&AgentOptions::default(), &mut executor)
             .unwrap();

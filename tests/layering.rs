@@ -43,6 +43,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ),
     // The package's `btc` command is the CLI's library.
     ("btc-python", &["btc", "btc-api"]),
+    ("btc-capi", &["btc-api", "btc-pddl"]),
     ("btc-lsp", &["btc-files", "btc-ir", "btc-lang", "btc-pddl"]),
     ("btc-testkit", &[]),
     ("btc-files", &[]),

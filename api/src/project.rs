@@ -224,6 +224,16 @@ impl Project {
         ))
     }
 
+    /// The world of `problem` (as [`Project::plan`] chooses it) as the
+    /// `.kb` text `btc compile --emit kb` writes: what btc's C++ knowledge
+    /// base (`integrations/btcpp`) reads.
+    pub fn knowledge_base(&mut self, problem: Option<&Path>) -> Result<String, Error> {
+        let job = self.job(problem)?;
+        self.refuse_errors(job, |d| d.span.file != self.plan_id(job))?;
+        let w = self.world_of(job)?;
+        Ok(btc_emit::kb::emit(w.domain, w.dix, w.problem, w.pix))
+    }
+
     /// The database, the compile job and the world of a plan still to be
     /// made, for the closed loop ([`crate::Agent`]).
     pub(crate) fn loop_job(

@@ -30,6 +30,30 @@ pub struct Tree {
     pytrees_refusals: Vec<Diagnostic>,
 }
 
+/// A leaf node id a tree uses, as BT.CPP registers it: what a host that
+/// builds the tree in its own factory must provide (or let btc's support
+/// library provide: a condition with a formula, a simulated action).
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct NodeInfo {
+    pub id: String,
+    /// `action` or `condition`.
+    pub kind: &'static str,
+    pub ports: Vec<PortInfo>,
+    /// For a condition the rules define by a formula: the formula over
+    /// `?port` variables, as PDDL text.
+    pub formula: Option<String>,
+}
+
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct PortInfo {
+    pub name: String,
+    /// `input` or `output`.
+    pub direction: &'static str,
+    /// The rules' type: a PDDL type, or `string`, `int`, `float`, `bool`.
+    #[serde(rename = "type")]
+    pub ty: String,
+}
+
 /// How a run goes.
 #[derive(Clone, Debug)]
 pub struct RunOptions {
@@ -101,6 +125,35 @@ impl Tree {
     /// The plan's steps, `(action arg ...)`.
     pub fn steps(&self) -> Vec<String> {
         self.ir.steps.iter().map(|s| s.display()).collect()
+    }
+
+    /// The leaf node ids the tree uses, with their ports (and formula, for
+    /// a condition the rules define by one), in the tree's model order.
+    pub fn nodes(&self) -> Vec<NodeInfo> {
+        self.ir
+            .nodes
+            .iter()
+            .map(|m| NodeInfo {
+                id: m.id.clone(),
+                kind: match m.kind {
+                    btc_ir::LeafKind::Action => "action",
+                    btc_ir::LeafKind::Condition => "condition",
+                },
+                ports: m
+                    .ports
+                    .iter()
+                    .map(|p| PortInfo {
+                        name: p.name.clone(),
+                        direction: match p.direction {
+                            btc_ir::PortDirection::Input => "input",
+                            btc_ir::PortDirection::Output => "output",
+                        },
+                        ty: p.ty.clone(),
+                    })
+                    .collect(),
+                formula: m.formula.as_ref().map(ToString::to_string),
+            })
+            .collect()
     }
 
     /// The tree in a target's form. py_trees is refused (with the

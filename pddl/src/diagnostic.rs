@@ -367,6 +367,9 @@ pub mod codes {
         C_CLASS_NAME = "C001", "a node whose name cannot become a C++ class of the executor";
         C_REGISTERED = "C002", "a node that BehaviorTree.CPP or btc's support library registers already";
         C_STALE_CLASS = "C003", "a class in the executor's nodes.hpp for a node the rules no longer declare";
+        // Embedding: btc's C API (btc-capi, the C++ library over it)
+        A_ARGUMENT = "A001", "a null pointer, a text that is not UTF-8 or a handle of another kind given to btc's C API";
+        A_INTERNAL = "A002", "a failure inside btc that its C API caught instead of crashing the host (a bug in btc)";
         // ARIAC trials (btc trial)
         TRIAL_SYNTAX = "T001", "a trial file that is not YAML btc reads";
         TRIAL_MISSING = "T002", "a trial field the ARIAC 2023 format requires is missing";

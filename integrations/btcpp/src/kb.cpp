@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 #include <unordered_map>
+#include <utility>
 
 #include "world.hpp"
 
@@ -32,6 +33,8 @@ struct Kb::Impl
   std::vector<int> current;
   std::vector<std::function<void(const StepEvent&)>> listeners;
   std::string last_failure;
+  std::string last_failure_why;
+  std::vector<ReportedFault> faults;
 
   std::vector<Id>& scratch() const
   {
@@ -272,11 +275,78 @@ void Kb::onStepEvent(std::function<void(const StepEvent&)> listener)
 void Kb::noteFailure(const std::string& node, const std::string& why)
 {
   p_->last_failure = node + ": " + why;
+  p_->last_failure_why = why;
+}
+
+const std::string& Kb::lastFailureWhy() const
+{
+  return p_->last_failure_why;
 }
 
 const std::string& Kb::lastFailure() const
 {
   return p_->last_failure;
+}
+
+// ------------------------------------------------------------------ between runs
+
+void Kb::setState(const std::vector<std::string>& facts)
+{
+  // The facts become one effect applied to an empty state: the same
+  // parser and checks as every effect, values through `assign`.
+  std::string effect = "(and";
+  for(const auto& f : facts)
+  {
+    const auto s = detail::readOne(f, "fact");
+    const bool value = s.isList() && s.items.size() == 3 && s.items[0].isName("=");
+    effect += value ? " (assign " + s.items[1].show() + " " + s.items[2].show() + ")" : " " + f;
+  }
+  effect += ")";
+  Effect e;
+  try
+  {
+    e = p_->world.compileEffect(detail::readOne(effect, "state"));
+  }
+  catch(const KbError& err)
+  {
+    throw KbError("a state that does not fit problem " + p_->world.problem + ": " + err.what());
+  }
+  State fresh;
+  Changes c;
+  p_->world.collect(fresh, e, p_->scratch(), c);
+  p_->world.apply(fresh, std::move(c));
+  p_->state = std::move(fresh);
+}
+
+void Kb::setGoal(const std::string& goal)
+{
+  try
+  {
+    p_->world.setGoal(p_->world.compileFormula(detail::readOne(goal, "goal")));
+  }
+  catch(const KbError& err)
+  {
+    throw KbError("`" + goal + "` is not a goal of problem " + p_->world.problem + ": " +
+                  err.what());
+  }
+}
+
+void Kb::resetSteps()
+{
+  p_->steps.clear();
+  p_->current.clear();
+  p_->last_failure.clear();
+  p_->last_failure_why.clear();
+}
+
+void Kb::reportFault(ReportedFault fault)
+{
+  p_->faults.push_back(std::move(fault));
+}
+
+std::vector<ReportedFault> Kb::takeFaults()
+{
+  return std::exchange(p_->faults, {});
 }
 
 // ------------------------------------------------------------------ text

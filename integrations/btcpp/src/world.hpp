@@ -175,6 +175,7 @@ public:
   std::size_t slots() const { return max_slots_; }
 
   const Formula* goal() const { return goal_ ? &*goal_ : nullptr; }
+  void setGoal(Formula g) { goal_ = std::move(g); }
 
 private:
   struct Scope;

@@ -65,6 +65,35 @@ struct StepEvent
   int step;
 };
 
+/// A fault a node reports (`Kb::reportFault`): one of ARIAC 2023's fault
+/// kinds, what it names, and how it changes the KB. The closed loop
+/// (`btc::Agent`) applies `retract` and `add` to the state it replans
+/// from and adjusts the goal as `btc run --replan` does: a spare part for
+/// a discarded one (`faulty_part`, `flipped_part` with a `part`), a
+/// priority order's `goal` first (`high_priority_order`).
+struct ReportedFault
+{
+  /// faulty_part, faulty_gripper, robot_malfunction, flipped_part,
+  /// sensor_blackout, high_priority_order, insufficient_parts,
+  /// human_too_close.
+  std::string kind;
+  std::optional<std::string> part;
+  std::optional<std::string> robot;
+  /// A priority order's goal, PDDL text.
+  std::optional<std::string> goal;
+  /// Facts no longer true, and facts now true, as PDDL atoms.
+  std::vector<std::string> retract;
+  std::vector<std::string> add;
+  /// What the node saw, in words (the fault record's reason).
+  std::string reason;
+  /// Its label in btc's report (empty: the kind).
+  std::string name;
+  /// How long it lasts, in ticks (a malfunction, a blackout, a human).
+  std::optional<long> duration;
+  /// The tick of the attempt it happened at (the agent sets it).
+  long tick = 0;
+};
+
 /// The knowledge base: shared by every node of a tree (`registerKbNodes`
 /// passes it to the nodes' constructors) and by the user's own nodes.
 /// Not thread-safe: use it from the thread that ticks the tree.
@@ -137,6 +166,27 @@ public:
   /// name and why), for the executor's summary.
   void noteFailure(const std::string& node, const std::string& why);
   const std::string& lastFailure() const;
+  /// The why of `lastFailure()` alone.
+  const std::string& lastFailureWhy() const;
+
+  // --- Between runs: the closed loop sets the state each attempt starts
+  // from, and collects the faults its nodes reported.
+
+  /// Replaces the state with these facts and values (`(at r1 a)`,
+  /// `(= (battery r1) 20.0)`, as `snapshot()` writes them); derived
+  /// predicates are recomputed. Throws `KbError` for a fact that does not
+  /// fit the problem.
+  void setState(const std::vector<std::string>& facts);
+  /// Replaces the goal (PDDL text).
+  void setGoal(const std::string& goal);
+  /// Forgets the plan's steps and the last failure: the next tree declares
+  /// its own.
+  void resetSteps();
+
+  /// Reports a fault: call it from a node that then returns FAILURE.
+  void reportFault(ReportedFault fault);
+  /// The faults reported since the last call, which forgets them.
+  std::vector<ReportedFault> takeFaults();
 
   /// How long simulated action leaves run: RUNNING for this many ticks,
   /// then SUCCESS (0: they succeed at once). `btc run --ticks-per-action`.
