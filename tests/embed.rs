@@ -457,9 +457,7 @@ fn the_knowledge_base_written_as_a_problem_plans_as_the_loop_does() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let faults = Faults::open(root.join("examples/ariac/faults/flipped_part.toml")).unwrap();
     let mut executor = WritingProblems {
-        inner: ReportingEngine {
-            faults: Some(faults),
-        },
+        inner: ReportingEngine::new(faults),
         project: open("ariac"),
         plans: Vec::new(),
     };
