@@ -55,6 +55,14 @@ const NO_FIXTURE: &[(&str, &str)] = &[
         "a tree of more than 65,535 nodes: runtime/src/btlog.rs tests it",
     ),
     (
+        "A001",
+        "the C API only (a null pointer, a handle of another kind): capi/tests/abi.rs",
+    ),
+    (
+        "A002",
+        "the C API only: a panic caught at the boundary (capi/src/boundary.rs); no input is known to panic",
+    ),
+    (
         "F006",
         "the language server only: lsp/tests/protocol.rs opens a document over the limit",
     ),

@@ -97,7 +97,9 @@ def _show(key):
 
 def _key(text):
     """A fact written `(on p bin1)` as the knowledge base keeps it."""
-    words = text.strip().removeprefix("(").removesuffix(")").split()
+    words = text.strip()
+    words = words[1:] if words.startswith("(") else words
+    words = (words[:-1] if words.endswith(")") else words).split()
     if not words:
         raise ValueError("`%s` is not a fact such as `(on p bin1)`" % text)
     return tuple(words)
