@@ -290,10 +290,10 @@ def test_the_package_is_a_complete_install_with_the_btc_command():
     assert version.returncode == 0
     assert version.stdout.strip() == f"btc {btc.__version__}"
     rules = ROOT / "examples" / "ariac" / "rules.btrules"
-    ours = subprocess.run(
-        [command, "compile", rules, "--emit", "btcpp"], capture_output=True, text=True, check=False
-    )
-    theirs = run_btc("compile", str(rules), "--emit", "btcpp")
+    plan = ROOT / "examples" / "ariac" / "plan.txt"
+    args = ["compile", str(rules), "--plan", str(plan), "--emit", "btcpp"]
+    ours = subprocess.run([command, *args], capture_output=True, text=True, check=False)
+    theirs = run_btc(*args)
     assert ours.returncode == 0, ours.stderr
     assert ours.stdout == theirs
     # Bad input: the command's own error and exit status, no traceback.
