@@ -2,15 +2,39 @@
 //! compiles the plan file, and the tree run in the carried world until it
 //! ends, a high-priority order preempts it, or the ticks run out.
 
-use super::carry::goal_formula;
+use super::carry::{goal_formula, Carry};
 use super::planning::Planned;
-use super::{push_event, Attempt, LoopError, Run};
+use super::{push_event, Attempt, LoopError, LoopSummary, Run};
 use btc_lang::db;
 use btc_pddl::logic::Formula;
 use btc_runtime::engine::{Engine, FaultRecord, Status};
 use btc_runtime::faults::FaultKind;
 use btc_runtime::{Kb, TreeDoc};
 use std::time::Instant;
+
+/// What an attempt leaves the next, wherever it ran: the goals faults added
+/// (returned: those new in this attempt), the KB's state, the tick, and
+/// whether the goal is reached (`reached`: the attempt may count as
+/// reaching it). Over the loop's fields, not `Run`: the KB borrows its
+/// world.
+pub(super) fn carry_over(
+    carry: &mut Carry,
+    out: &mut LoopSummary,
+    kb: &mut Kb<'_>,
+    tick: u64,
+    reached: bool,
+) -> Vec<Formula> {
+    let mut added = kb.extra_goals();
+    added.retain(|a| !carry.extra_goals.contains(a));
+    carry.extra_goals.extend(added.iter().cloned());
+    let (goal_ok, goal_why) = kb.goal();
+    carry.state = Some(std::mem::take(&mut kb.state));
+    carry.tick = tick;
+    out.ticks = tick;
+    out.goal_reached = goal_ok && reached;
+    out.goal_failure = goal_why;
+    added
+}
 
 /// What planning and compiling an attempt made, before it runs.
 pub(super) struct Compiled {
@@ -209,16 +233,9 @@ impl Run<'_, '_> {
         }
         let discarded = engine.discarded_parts();
         let kb = engine.kb.as_mut().expect("built with a KB");
-        let mut added = kb.extra_goals();
-        added.retain(|a| !self.carry.extra_goals.contains(a));
-        self.carry.extra_goals.extend(added.iter().cloned());
-        let (goal_ok, goal_why) = kb.goal();
-        self.carry.state = Some(std::mem::take(&mut kb.state));
-        self.carry.tick = engine.tick;
+        let reached = done && !c.for_priority;
+        let added = carry_over(&mut self.carry, &mut self.out, kb, engine.tick, reached);
         self.carry.faults = Some(engine.take_faults());
-        self.out.ticks = self.carry.tick;
-        self.out.goal_reached = goal_ok && done && !c.for_priority;
-        self.out.goal_failure = goal_why;
         self.out.attempts.push(c.record(RunPart {
             run_ms,
             start_tick,

@@ -6,7 +6,7 @@
 //! KB as the same fault in a scenario would, a discarded part gets a spare,
 //! an order's goal comes first.
 
-use super::attempt::{Compiled, Ran, RunPart};
+use super::attempt::{carry_over, Compiled, Ran, RunPart};
 use super::carry::goal_formula;
 use super::{LoopError, Run};
 use btc_ir::TreeIr;
@@ -215,16 +215,15 @@ impl Run<'_, '_> {
             until.saturating_sub(end_tick)
         };
         let end_tick_waited = end_tick + waited;
-        let (goal_ok, goal_why) = kb.goal();
-        let mut added = kb.extra_goals();
-        added.retain(|a| !self.carry.extra_goals.contains(a));
-        self.carry.extra_goals.extend(added.iter().cloned());
-        self.carry.state = Some(std::mem::take(&mut kb.state));
+        let reached = done && !c.for_priority;
+        let added = carry_over(
+            &mut self.carry,
+            &mut self.out,
+            &mut kb,
+            end_tick_waited,
+            reached,
+        );
         self.carry.faults = Some(happened);
-        self.carry.tick = end_tick_waited;
-        self.out.ticks = end_tick_waited;
-        self.out.goal_reached = goal_ok && done && !c.for_priority;
-        self.out.goal_failure = goal_why;
         self.note_reported(&ex, start_tick, done);
         let steps_total = ir.steps.len();
         self.out.attempts.push(c.record(RunPart {
