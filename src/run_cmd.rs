@@ -58,6 +58,11 @@ pub struct RunArgs {
     /// Ticks an action leaf stays RUNNING before it succeeds.
     #[arg(long, default_value_t = 1)]
     pub ticks_per_action: u32,
+    /// Ticks per time unit of a timed plan: a step with duration d lasts
+    /// at least d times this many ticks (0: steps take as long as their
+    /// actions, durations are not simulated).
+    #[arg(long, default_value_t = 0, conflicts_with = "replan")]
+    pub ticks_per_time_unit: u32,
     /// Wall-clock milliseconds between ticks (also the simulated time
     /// per tick; 0: as fast as possible, 10 ms simulated).
     #[arg(long, default_value_t = 0)]
@@ -384,6 +389,9 @@ fn execute(
         Ok(e) => e,
         Err(e) => return fail(&[diagnostic(&e, tree_file, sources)], sources, a.format),
     };
+    if a.ticks_per_time_unit > 0 {
+        engine.simulate_durations(a.ticks_per_time_unit);
+    }
     // Warnings about the scenario (X011), in the JSON summary's `diagnostics`.
     let mut warned = Vec::new();
     if let Some(path) = &a.faults {

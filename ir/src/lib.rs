@@ -272,8 +272,9 @@ pub struct StepInfo {
     pub skipped: bool,
     pub time: Option<f64>,
     pub duration: Option<f64>,
-    /// Steps that must finish before this one (`steps parallel`). One
-    /// pointer wide, as most steps have none and a long plan has many.
+    /// Steps that must finish before this one (`steps parallel`, `steps
+    /// scheduled`). One pointer wide, as most steps have none and a long
+    /// plan has many.
     pub after: ThinVec<usize>,
     /// Shared between the steps that repeat a ground action (plans repeat
     /// them a lot: a long plan would otherwise hold one copy of each per

@@ -494,11 +494,11 @@ pub fn markdown_table() -> String {
 
 /// The VS Code grammar's pattern for template keywords: the vocabulary's,
 /// longest first so that no keyword shadows a longer one, then `steps`
-/// and `backchained`.
+/// and its modes `backchained` and `scheduled`.
 pub fn grammar_keyword_pattern() -> String {
     let mut words: Vec<&str> = NODES.iter().map(|s| s.keyword).collect();
     words.sort_by(|a, b| b.len().cmp(&a.len()).then(a.cmp(b)));
-    words.extend(["steps", "backchained"]);
+    words.extend(["steps", "backchained", "scheduled"]);
     format!(
         "(?<![A-Za-z0-9_?-])(?:{})(?![A-Za-z0-9_-])",
         words.join("|")

@@ -2,7 +2,7 @@
 //! against the rules (first match in file order), the rule's template
 //! becomes a parametric tree called with the step's bindings, KB effects
 //! and conditions are attached, and the `plan { ... }` template arranges the
-//! steps (`steps`, `steps backchained`, `steps parallel`).
+//! steps (`steps`, `steps backchained`, `steps parallel`, `steps scheduled`).
 
 use crate::rules::ast::*;
 use crate::rules::check::Decls;
@@ -120,7 +120,8 @@ pub fn lower(input: &LowerInput) -> Result<TreeIr, Vec<Diagnostic>> {
 }
 
 /// The plan's tree: the `plan { ... }` template with the step nodes
-/// arranged where it says `steps` (in order, backchained or parallel), or
+/// arranged where it says `steps` (in order, backchained, parallel or
+/// scheduled), or
 /// the steps in order without one.
 fn arrange_plan(
     input: &LowerInput,
@@ -133,6 +134,12 @@ fn arrange_plan(
     let uses_parallel = template.is_some_and(|t| uses_mode(t, StepsMode::Parallel));
     if uses_parallel {
         arrange::order_steps(infos);
+    } else if template.is_some_and(|t| uses_mode(t, StepsMode::Scheduled)) {
+        let unstated = unstated_durations(input, infos);
+        if !unstated.is_empty() {
+            return Err(unstated);
+        }
+        arrange::schedule_steps(infos, btc_pddl::validate::DEFAULT_EPSILON);
     }
     // The plan template holds `steps` once (R022): the step nodes move into
     // it instead of being copied.
@@ -162,7 +169,7 @@ fn arrange_plan(
                     }
                 }
             }
-            StepsMode::Parallel => vec![arrange::parallel(&nodes, infos)],
+            StepsMode::Parallel | StepsMode::Scheduled => vec![arrange::parallel(&nodes, infos)],
         }
     };
     let root = match template {
@@ -250,6 +257,37 @@ fn backchain_diagnostic(e: backchain::Breaks, input: &LowerInput) -> Diagnostic 
         ),
     )
     .with_hint("the plan does not reach its goal from this step on; plan again, or use `steps` to run it as written")
+}
+
+/// `steps scheduled` on a timed plan needs each durative step's end, so
+/// its stated duration (R035 at each step without one): the domain's
+/// `:duration` may depend on the state, and guessing it would schedule
+/// the plan differently from the planner that wrote it.
+fn unstated_durations(input: &LowerInput, infos: &[StepInfo]) -> Vec<Diagnostic> {
+    if infos.iter().any(|s| s.time.is_none()) {
+        return Vec::new();
+    }
+    input
+        .steps
+        .iter()
+        .zip(infos)
+        .filter(|(g, s)| {
+            !s.skipped && s.duration.is_none() && input.domain.actions[g.action].durative
+        })
+        .map(|(g, s)| {
+            let span = input.plan.steps[g.step].span;
+            Diagnostic::error(
+                codes::R_SCHEDULE_DURATION,
+                span,
+                format!(
+                    "step {} (`{}`) is durative and states no duration: `steps scheduled` cannot tell when it ends",
+                    s.index + 1,
+                    s.logic.action
+                ),
+            )
+            .with_hint("write the step's duration after it, as temporal planners do (`0.000: (move r1 a b) [5.000]`)")
+        })
+        .collect()
 }
 
 fn uses_mode(ts: &[Template], mode: StepsMode) -> bool {

@@ -25,6 +25,7 @@ pub const OTHER_KEYWORDS: &[&str] = &[
     "false",
     "std",
     "backchained",
+    "scheduled",
 ];
 
 /// The tokens of a file with absolute spans, and its comments (lexed once

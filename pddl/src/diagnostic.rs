@@ -287,6 +287,7 @@ pub mod codes {
         PLAN_TYPE = "L005", "a plan step argument whose type does not fit the action";
         PLAN_EMPTY = "L006", "a plan with no steps";
         PLAN_MISFIT = "L010", "a plan whose object names are not those of its problem";
+        PLAN_CONCURRENT_IN_ORDER = "L011", "a timed plan with concurrent steps that plain `steps` runs one after another";
         // Validation
         PRECONDITION_FAILS = "V001", "a plan step whose precondition does not hold";
         GOAL_NOT_REACHED = "V002", "a plan that does not reach the goal";
@@ -329,6 +330,7 @@ pub mod codes {
         R_NO_RULES = "R025", "a rules file with a domain and no rules yet";
         R_EFFECT_UNBOUND = "R033", "a rule effect that reads an optional parameter a step leaves out";
         R_BACKCHAIN = "R034", "a plan `steps backchained` cannot regress its goal through";
+        R_SCHEDULE_DURATION = "R035", "a timed plan's durative step without a stated duration, which `steps scheduled` needs";
         // .btrules: rules that no step can match, and skips that lose effects
         R_CONTRADICTION = "R040", "a rule whose guards contradict each other, so no step matches it";
         R_GUARD_TYPE = "R041", "a type guard that the variable's type can never fit";

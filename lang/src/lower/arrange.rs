@@ -1,6 +1,6 @@
-//! How the plan's steps are put together for `steps parallel` (plain
-//! `steps` is the steps in order; `steps backchained` is in
-//! [`super::backchain`]). Both read each step's ground conditions and
+//! How the plan's steps are put together for `steps parallel` and `steps
+//! scheduled` (plain `steps` is the steps in order; `steps backchained` is
+//! in [`super::backchain`]). Both read each step's ground conditions and
 //! effects from its [`StepInfo`], so a rule's `effect` orders and guards
 //! steps exactly as it changes the KB.
 
@@ -76,6 +76,47 @@ pub(super) fn order_steps(infos: &mut [StepInfo]) {
             }
         }
         infos[j].after = after.into();
+    }
+}
+
+/// Orders steps by the timed plan's schedule, as PlanSys2's executor does:
+/// step j comes after an earlier step i when i ends before j starts
+/// (`end_i <= start_j`, events less than a tenth of `epsilon` apart being
+/// one happening, as the validator has them; among steps of one happening
+/// the plan's order decides). Only the direct predecessors are kept: i is
+/// left out when it also ends before a later predecessor k of j starts,
+/// since k's wait covers it. A plan without times is a sequence: each step
+/// after the one before. Skipped steps neither wait nor are waited for.
+pub(super) fn schedule_steps(infos: &mut [StepInfo], epsilon: f64) {
+    let live: Vec<usize> = (0..infos.len()).filter(|&i| !infos[i].skipped).collect();
+    if !live.iter().all(|&i| infos[i].time.is_some()) {
+        for (k, &j) in live.iter().enumerate() {
+            infos[j].after = live[..k].last().copied().into_iter().collect();
+        }
+        return;
+    }
+    let tol = epsilon / 10.0;
+    let start = |s: &StepInfo| s.time.unwrap_or(0.0);
+    let end = |s: &StepInfo| start(s) + s.duration.unwrap_or(0.0);
+    for (n, &j) in live.iter().enumerate() {
+        let sj = start(&infos[j]);
+        let before: Vec<usize> = live[..n]
+            .iter()
+            .copied()
+            .filter(|&i| end(&infos[i]) <= sj + tol)
+            .collect();
+        // The latest start among the predecessors after each one.
+        let mut latest_after = vec![f64::NEG_INFINITY; before.len()];
+        for m in (0..before.len().saturating_sub(1)).rev() {
+            latest_after[m] = latest_after[m + 1].max(start(&infos[before[m + 1]]));
+        }
+        let direct: Vec<usize> = before
+            .iter()
+            .zip(&latest_after)
+            .filter(|&(&i, &later)| end(&infos[i]) > later + tol)
+            .map(|(&i, _)| i)
+            .collect();
+        infos[j].after = direct.into();
     }
 }
 

@@ -4,6 +4,7 @@
 //! report the same diagnostics in the same order ([`report`]). Which problem
 //! a plan goes with is decided here too ([`job`]).
 
+pub mod concurrent;
 pub mod disk;
 pub mod fit;
 pub mod job;

@@ -323,6 +323,9 @@ pub enum StepsMode {
     InOrder,
     Parallel,
     Backchained,
+    /// The plan's own schedule: each step starts once the steps that end
+    /// before it starts (in the timed plan) have ended.
+    Scheduled,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

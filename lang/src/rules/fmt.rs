@@ -342,6 +342,7 @@ fn template_line(t: &Template) -> String {
             StepsMode::InOrder => "steps".into(),
             StepsMode::Parallel => "steps parallel".into(),
             StepsMode::Backchained => "steps backchained".into(),
+            StepsMode::Scheduled => "steps scheduled".into(),
         },
         _ => unreachable!("controls and decorators are printed by `template`"),
     }

@@ -122,6 +122,7 @@ impl<'w> Engine<'w> {
             let mut rt = StepRt {
                 label: s.label(),
                 skipped: s.skipped,
+                duration: s.duration,
                 ..StepRt::default()
             };
             if !s.skipped {

@@ -1,6 +1,8 @@
 //! Plan steps: a step node wraps the subtree of one plan step; it checks
 //! the step's conditions and applies its effects to the KB, each time it
-//! runs.
+//! runs. With durations simulated ([`Engine::simulate_durations`]), a
+//! timed step whose subtree is done sooner holds RUNNING until its
+//! duration in ticks has passed since it started.
 
 use super::record::Reason;
 use super::{Engine, NodeDef, Status, TraceItem};
@@ -18,6 +20,14 @@ pub(crate) struct StepRt {
     pub skipped: bool,
     pub started: bool,
     pub finished: bool,
+    /// The plan's stated duration of the step, in plan time units.
+    pub duration: Option<f64>,
+    /// Ticks the step lasts at least (0: as long as its subtree).
+    pub min_ticks: u64,
+    /// The tick it last started at.
+    pub started_tick: u64,
+    /// Its subtree is done and it waits for its duration to pass.
+    pub holding: bool,
 }
 
 impl StepRt {
@@ -34,6 +44,19 @@ impl StepRt {
 }
 
 impl<'w> Engine<'w> {
+    /// Makes each timed step last at least its duration times
+    /// `ticks_per_unit` ticks (rounded up; 0 turns it off, the default):
+    /// `btc run --ticks-per-time-unit`.
+    pub fn simulate_durations(&mut self, ticks_per_unit: u32) {
+        for s in &mut self.steps {
+            s.min_ticks = match s.duration {
+                // Rounded up, with a little slack so that 0.1 * 10 is 1.
+                Some(d) if d > 0.0 => (d * f64::from(ticks_per_unit) - 1e-9).ceil().max(0.0) as u64,
+                _ => 0,
+            };
+        }
+    }
+
     #[inline(never)]
     pub(super) fn tick_step(&mut self, i: u32, def: NodeDef, k: u32) -> Status {
         let iu = i as usize;
@@ -44,6 +67,10 @@ impl<'w> Engine<'w> {
                 self.faults_on_step(ku);
             }
             self.step_running = Some(k);
+            if let Some(st) = self.steps.get_mut(ku) {
+                st.started_tick = self.tick;
+                st.holding = false;
+            }
             if self.opts.trace {
                 self.trace.push(TraceItem::StepStarted {
                     tick: self.tick,
@@ -70,14 +97,23 @@ impl<'w> Engine<'w> {
                 }
             }
         }
-        let c = self.kid(def, 0);
-        let s = self.tick_node(c);
-        if !s.is_done() {
-            return s;
+        if !self.steps.get(ku).is_some_and(|st| st.holding) {
+            let c = self.kid(def, 0);
+            let s = self.tick_node(c);
+            if !s.is_done() {
+                return s;
+            }
+            self.reset(c);
+            if s == Status::Failure {
+                return s;
+            }
         }
-        self.reset(c);
-        if s == Status::Failure {
-            return s;
+        if let Some(st) = self.steps.get_mut(ku) {
+            if self.tick < st.started_tick.saturating_add(st.min_ticks) {
+                st.holding = true;
+                return Status::Running;
+            }
+            st.holding = false;
         }
         if let Some(st) = self.steps.get(ku) {
             if let (Some(pre), Some(kb)) = (st.pre_end, self.kb.as_ref()) {

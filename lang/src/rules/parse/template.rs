@@ -110,7 +110,7 @@ fn decorator<'t, I: Tokens<'t>, R: ItemError<'t, I> + 't, T: Templates<'t, I, R>
         )
 }
 
-/// `steps`, `steps parallel`, `steps backchained`.
+/// `steps`, `steps parallel`, `steps backchained`, `steps scheduled`.
 fn steps<'t, I: Tokens<'t>, R: ItemError<'t, I> + 't>(
     file: FileId,
 ) -> impl Parser<'t, I, Template, extra::Err<R>> + Clone {
@@ -122,6 +122,7 @@ fn steps<'t, I: Tokens<'t>, R: ItemError<'t, I> + 't>(
                     .then_ignore(punct("(").not().rewind())
                     .to(StepsMode::Parallel),
                 kw("backchained").to(StepsMode::Backchained),
+                kw("scheduled").to(StepsMode::Scheduled),
             ))
             .or_not(),
         )
