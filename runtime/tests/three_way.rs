@@ -130,6 +130,58 @@ fn three_ways(ex: &Example, name: &str) -> Outcome {
     from_ir
 }
 
+/// A timed plan's order kept: for every two steps where one ends before
+/// the other starts in the plan (within IPC's tolerance), the run ends the
+/// first before it starts the second. With `concurrent` (`steps
+/// scheduled`), steps the plan overlaps overlap in the run too (one starts
+/// before the other ends): not every such pair, as a step starts when what
+/// it waits for has ended, not at its time, and the actions take their
+/// ticks rather than their durations; without (`steps`), none does. (Every
+/// execution gives the same events, so checking one checks all three.)
+fn follows_schedule(ex: &Example, o: &Outcome, name: &str, concurrent: bool) {
+    let steps = &ex.ir.steps;
+    if steps.is_empty() || steps.iter().any(|s| s.time.is_none()) {
+        assert!(!concurrent, "{name}: `steps scheduled` jobs need a timed plan");
+        return;
+    }
+    let tol = btc_pddl::validate::DEFAULT_EPSILON / 10.0;
+    let at = |what: &str, step: usize| {
+        o.events
+            .iter()
+            .position(|(_, w, s)| w == what && *s == step)
+            .unwrap_or_else(|| panic!("{name}: step {step} has no {what}"))
+    };
+    let span = |s: &btc_ir::StepInfo| {
+        let t = s.time.unwrap_or(0.0);
+        (t, t + s.duration.unwrap_or(0.0))
+    };
+    let mut overlapped = 0;
+    for (i, a) in steps.iter().enumerate().filter(|(_, s)| !s.skipped) {
+        for (j, b) in steps.iter().enumerate().filter(|(_, s)| !s.skipped) {
+            let ((start_a, end_a), (start_b, end_b)) = (span(a), span(b));
+            if i < j && end_a <= start_b + tol {
+                assert!(
+                    at("end", i + 1) < at("start", j + 1),
+                    "{name}: step {} ends at {end_a} in the plan, before step {} starts at {start_b},                      but not in the run: {:?}",
+                    i + 1,
+                    j + 1,
+                    o.events
+                );
+            } else if i < j && start_b < end_a - tol && start_a < end_b - tol {
+                let run_overlaps =
+                    at("start", j + 1) < at("end", i + 1) && at("start", i + 1) < at("end", j + 1);
+                overlapped += usize::from(run_overlaps);
+            }
+        }
+    }
+    assert_eq!(
+        concurrent,
+        overlapped > 0,
+        "{name}: {overlapped} pairs of steps the plan overlaps overlap in the run: {:?}",
+        o.events
+    );
+}
+
 /// Every `*.btrules` not starting with `_` in `dir`, with the folder's
 /// problem and first plan.
 fn folder_jobs(dir: &Path) -> Vec<(String, Example)> {
@@ -217,6 +269,7 @@ fn rules_fixtures_mean_the_same_in_every_executor() {
                 rules.replace('.', "_")
             );
             let o = three_ways(&ex, &name);
+            follows_schedule(&ex, &o, &name, rules.starts_with("scheduled"));
             let reached = o.status == "SUCCESS" && o.goal_reached;
             if KNOWN_UNREACHED.contains(&name.as_str()) {
                 assert!(
