@@ -8,7 +8,9 @@
 //! executor with the generated nodes (whose default bodies simulate the
 //! actions as `btc run` does) and by `btc run`; the step starts and ends
 //! (with their ticks), the final status, the goal check and the final KB
-//! must be the same.
+//! must be the same. A timed plan with concurrent steps (three robots, as
+//! PlanSys2's bt_example) runs `steps scheduled` and `steps`: in BT.CPP too,
+//! every step the plan ends before another starts ends first.
 //!
 //! Build cost: the support library is compiled once, and every rules file's
 //! generated nodes go into one executable (`all.cpp` below dispatches on
@@ -118,6 +120,18 @@ fn rule_sets() -> Vec<RuleSet> {
             }],
         });
     }
+    let timed = repo().join("runtime/tests/fixtures/three_way/timed");
+    for arrangement in ["scheduled", "in_order"] {
+        sets.push(RuleSet {
+            name: format!("timed_{arrangement}"),
+            rules: timed.join(format!("{arrangement}.btrules")),
+            jobs: vec![Job {
+                plan: timed.join("plan.tplan"),
+                problem: timed.join("problem.pddl"),
+                ticks: vec![0, 2],
+            }],
+        });
+    }
     for d in btc_testkit::corpus_rules().unwrap_or_default() {
         sets.push(RuleSet {
             jobs: d
@@ -212,6 +226,33 @@ fn from_btc_run(summary: &str, trace: &str) -> Outcome {
             .map(|f| f.as_str().unwrap().to_owned())
             .collect(),
     }
+}
+
+/// For a timed plan: the first pair of steps where the plan ends the first
+/// before the second starts (within IPC's tolerance) and the run (its
+/// events in their order) does not, if any.
+fn plan_order_broken(plan: &Path, steps: &[(u64, bool, u64)]) -> Option<(usize, usize)> {
+    let text = std::fs::read_to_string(plan).unwrap();
+    let (plan, _) = btc_pddl::plan::parse_plan(&text, 0);
+    if plan.steps.iter().any(|s| s.time.is_none()) {
+        return None;
+    }
+    let tol = btc_pddl::validate::DEFAULT_EPSILON / 10.0;
+    let at = |started: bool, step: usize| {
+        steps
+            .iter()
+            .position(|&(_, s, k)| s == started && k == step as u64)
+            .unwrap_or(usize::MAX)
+    };
+    let ends = |s: &btc_pddl::plan::PlanStep| s.time.unwrap_or(0.0) + s.duration.unwrap_or(0.0);
+    for (i, a) in plan.steps.iter().enumerate() {
+        for (j, b) in plan.steps.iter().enumerate().skip(i + 1) {
+            if ends(a) <= b.time.unwrap_or(0.0) + tol && at(false, i + 1) > at(true, j + 1) {
+                return Some((i + 1, j + 1));
+            }
+        }
+    }
+    None
 }
 
 /// `btc compile` to `out`, which must succeed.
@@ -388,6 +429,12 @@ fn generated_executors_run_every_plan_as_btc_run_does() {
                         s.name
                     );
                     assert!(!got.steps.is_empty() && !got.kb.is_empty());
+                    assert_eq!(
+                        plan_order_broken(&job.plan, &got.steps),
+                        None,
+                        "{} {plan}: a step (left) the plan ends before another (right) starts does not end first in BT.CPP",
+                        s.name
+                    );
                     if got.status == "SUCCESS" {
                         assert!(got.goal, "{} {plan}", s.name);
                     } else {
@@ -400,7 +447,7 @@ fn generated_executors_run_every_plan_as_btc_run_does() {
     }
     // The examples, workshop and failing plans at least (and the corpus
     // when it is there); exactly the failing plan's runs fail.
-    assert!(compared >= 44, "{compared} runs compared");
+    assert!(compared >= 56, "{compared} runs compared");
     assert_eq!(failed_alike, 2, "only the plan that grasps first fails");
     palette_written_by_btcpp_imports_and_checks(&exe, &work);
 }

@@ -141,7 +141,10 @@ fn three_ways(ex: &Example, name: &str) -> Outcome {
 fn follows_schedule(ex: &Example, o: &Outcome, name: &str, concurrent: bool) {
     let steps = &ex.ir.steps;
     if steps.is_empty() || steps.iter().any(|s| s.time.is_none()) {
-        assert!(!concurrent, "{name}: `steps scheduled` jobs need a timed plan");
+        assert!(
+            !concurrent,
+            "{name}: `steps scheduled` jobs need a timed plan"
+        );
         return;
     }
     let tol = btc_pddl::validate::DEFAULT_EPSILON / 10.0;

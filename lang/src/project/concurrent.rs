@@ -59,10 +59,13 @@ fn end(s: &PlanStep) -> f64 {
 /// they order the plan themselves).
 fn runs_in_order(db: &dyn Db, job: CompileJob) -> bool {
     let rules = job.rules(db);
-    let template = parsed_rules(db, rules).items.iter().find_map(|n| match &*n.item {
-        Item::Plan { body, .. } => Some(body.clone()),
-        _ => None,
-    });
+    let template = parsed_rules(db, rules)
+        .items
+        .iter()
+        .find_map(|n| match &*n.item {
+            Item::Plan { body, .. } => Some(body.clone()),
+            _ => None,
+        });
     let Some(body) = template else {
         return true;
     };

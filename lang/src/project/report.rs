@@ -178,7 +178,11 @@ pub fn job_report(db: &dyn Db, job: CompileJob) -> Vec<FileReport> {
         );
     } else {
         diagnostics.extend(super::misfit::plan_diagnostics(db, job).iter().cloned());
-        diagnostics.extend(super::concurrent::in_order_diagnostics(db, job).iter().cloned());
+        diagnostics.extend(
+            super::concurrent::in_order_diagnostics(db, job)
+                .iter()
+                .cloned(),
+        );
     }
     out.push(FileReport {
         file: plan,
