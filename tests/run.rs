@@ -492,3 +492,29 @@ fn fmt_keeps_the_scripts_of_a_rules_file() {
         "btc fmt --check tests/fixtures/scripts/rules.btrules",
     );
 }
+
+#[test]
+fn a_timed_plans_durations_become_ticks_on_request() {
+    let dir = "runtime/tests/fixtures/three_way/timed";
+    let rules = format!("{dir}/scheduled.btrules");
+    let plan = format!("{dir}/plan.tplan");
+    let ticks = |per_unit: &str| {
+        let s = summary_of(
+            &["run", &rules, "--plan", &plan, "--ticks-per-time-unit", per_unit],
+            0,
+        );
+        assert_eq!(s["goal_reached"], true, "{s}");
+        s["ticks"].as_u64().unwrap()
+    };
+    // Off by default: the steps take their actions' ticks, as before.
+    let default = summary_of(&["run", &rules, "--plan", &plan], 0);
+    assert_eq!(default["ticks"].as_u64().unwrap(), ticks("0"));
+    // Five-unit steps one after another on each robot's chain: the run
+    // grows with the ticks per unit, about as the plan's makespan (37).
+    let (ten, hundred) = (ticks("10"), ticks("100"));
+    assert!((300..=420).contains(&ten), "{ten} ticks");
+    assert!((3000..=4000).contains(&hundred), "{hundred} ticks");
+    // Replanning makes its own plans: the option is refused with it.
+    let out = btc(&["run", &rules, "--replan", "--ticks-per-time-unit", "5"]);
+    assert_eq!(out.status.code(), Some(2));
+}
