@@ -500,7 +500,14 @@ fn a_timed_plans_durations_become_ticks_on_request() {
     let plan = format!("{dir}/plan.tplan");
     let ticks = |per_unit: &str| {
         let s = summary_of(
-            &["run", &rules, "--plan", &plan, "--ticks-per-time-unit", per_unit],
+            &[
+                "run",
+                &rules,
+                "--plan",
+                &plan,
+                "--ticks-per-time-unit",
+                per_unit,
+            ],
             0,
         );
         assert_eq!(s["goal_reached"], true, "{s}");
