@@ -109,29 +109,21 @@ fn rule_sets() -> Vec<RuleSet> {
         }],
     });
     let workshop = repo().join("lang/tests/fixtures/pytrees/workshop");
-    for arrangement in ["in_order", "backchained", "parallel"] {
-        sets.push(RuleSet {
-            name: format!("workshop_{arrangement}"),
-            rules: workshop.join(format!("{arrangement}.btrules")),
-            jobs: vec![Job {
-                plan: workshop.join("plan.txt"),
-                problem: workshop.join("problem.pddl"),
-                ticks: vec![0, 2],
-            }],
-        });
-    }
+    arrangements(
+        &mut sets,
+        "workshop",
+        &workshop,
+        "plan.txt",
+        &["in_order", "backchained", "parallel"],
+    );
     let timed = repo().join("runtime/tests/fixtures/three_way/timed");
-    for arrangement in ["scheduled", "in_order"] {
-        sets.push(RuleSet {
-            name: format!("timed_{arrangement}"),
-            rules: timed.join(format!("{arrangement}.btrules")),
-            jobs: vec![Job {
-                plan: timed.join("plan.tplan"),
-                problem: timed.join("problem.pddl"),
-                ticks: vec![0, 2],
-            }],
-        });
-    }
+    arrangements(
+        &mut sets,
+        "timed",
+        &timed,
+        "plan.tplan",
+        &["scheduled", "in_order"],
+    );
     for d in btc_testkit::corpus_rules().unwrap_or_default() {
         sets.push(RuleSet {
             jobs: d
@@ -523,4 +515,20 @@ fn palette_written_by_btcpp_imports_and_checks(exe: &Path, work: &Path) {
         declared.contains(r#"name="step" type="int""#),
         "the label is on WaitForStep's port: {declared}"
     );
+}
+
+/// One rule set per arrangement of a fixture folder (`NAME.btrules` beside
+/// one plan and its problem), each run for 0 and 2 ticks an action.
+fn arrangements(sets: &mut Vec<RuleSet>, prefix: &str, dir: &Path, plan: &str, names: &[&str]) {
+    for arrangement in names {
+        sets.push(RuleSet {
+            name: format!("{prefix}_{arrangement}"),
+            rules: dir.join(format!("{arrangement}.btrules")),
+            jobs: vec![Job {
+                plan: dir.join(plan),
+                problem: dir.join("problem.pddl"),
+                ticks: vec![0, 2],
+            }],
+        });
+    }
 }
