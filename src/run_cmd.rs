@@ -11,6 +11,8 @@ use btc_pddl::pipeline;
 use btc_pddl::source::{FileId, Sources, Span};
 use btc_pddl::state::World;
 use btc_pddl::world::WorldModel;
+use btc_runtime::btlog::BtlogRecorder;
+use btc_runtime::observers::JsonlTrace;
 use btc_runtime::{Controller, Engine, Kb, LoadError, Loaded, Options, Scenario, Summary, TreeDoc};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -379,7 +381,6 @@ fn execute(
     let opts = Options {
         ticks_per_action: a.ticks_per_action,
         ms_per_tick: if a.tick_ms > 0 { a.tick_ms } else { 10 },
-        trace: a.trace.is_some() || a.btlog.is_some(),
     };
     let ms_per_tick = opts.ms_per_tick;
     let started = std::time::SystemTime::now()
@@ -422,17 +423,20 @@ fn execute(
     });
     let pace = Duration::from_millis(a.tick_ms);
     // The trace goes out tick by tick: bounded memory, and a killed run
-    // leaves every line so far (SIGINT/SIGTERM flush it).
+    // leaves every line so far (SIGINT/SIGTERM flush it). The Groot2
+    // replay is an observer of its own, so each file gets every event.
     let trace = a.trace.as_deref().map(files::stream).transpose()?;
-    // The trace file is written (and the trace forgotten) tick by tick; a
-    // `.btlog`, written at the end, needs every transition: it keeps them.
-    let mut for_btlog = Vec::new();
-    let mut stream = |e: &mut Engine<'_>, t: &btc_files::Stream| {
-        if a.btlog.is_some() {
-            for_btlog.extend(e.trace.iter().cloned());
+    if trace.is_some() {
+        engine.observe(JsonlTrace::default());
+    }
+    if a.btlog.is_some() {
+        engine.observe(BtlogRecorder::new(ms_per_tick));
+    }
+    let stream = |e: &mut Engine<'_>, t: &btc_files::Stream| {
+        if let Some(lines) = e.observer_mut::<JsonlTrace>() {
+            let mut w: &btc_files::Stream = t;
+            let _ = lines.drain(&mut w).and_then(|()| t.flush());
         }
-        let mut w: &btc_files::Stream = t;
-        let _ = e.drain_trace(&mut w).and_then(|()| t.flush());
     };
     let status = engine.run(a.max_ticks, |e| {
         if let Some(t) = &trace {
@@ -454,10 +458,9 @@ fn execute(
         stream(&mut engine, &t);
         t.finish()
             .map_err(|e| anyhow::anyhow!("cannot write `{}`: {e}", path.display()))?;
-        engine.trace = for_btlog;
     }
-    if let Some(path) = &a.btlog {
-        match btc_runtime::btlog::write(doc, &engine, status, ms_per_tick, started) {
+    if let (Some(path), Some(replay)) = (&a.btlog, engine.take_observer::<BtlogRecorder>()) {
+        match replay.finish(doc, &engine, status, started) {
             Ok(bytes) => files::write_bytes_atomically(path, &bytes)?,
             Err(e) => return fail(&[diagnostic(&e, tree_file, sources)], sources, a.format),
         }
@@ -591,8 +594,8 @@ fn run_replan(a: &RunArgs, rules: &Path) -> anyhow::Result<ExitCode> {
         engine: Options {
             ticks_per_action: a.ticks_per_action,
             ms_per_tick: if a.tick_ms > 0 { a.tick_ms } else { 10 },
-            trace: a.trace.is_some(),
         },
+        trace: a.trace.is_some(),
         planner: btc_planner::Options::default(),
         max_replans: a.max_replans,
         max_ticks: a.max_ticks,

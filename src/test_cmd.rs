@@ -15,6 +15,7 @@ use btc_emit as emit;
 use btc_lang::path::FilePath;
 use btc_lang::project::PlanSource;
 use btc_pddl::state::World;
+use btc_runtime::observers::JsonlTrace;
 use btc_runtime::{Engine, Kb, Options, TreeDoc};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -136,21 +137,21 @@ fn run_text(
 ) -> anyhow::Result<String> {
     let world = World::new(ir.world.clone()).map_err(anyhow::Error::msg)?;
     let doc = TreeDoc::from_ir(ir);
-    let opts = Options {
-        trace: true,
-        ..Options::default()
-    };
-    let mut engine = Engine::build(&doc, Some(Kb::new(&world)), opts)
+    let mut engine = Engine::build(&doc, Some(Kb::new(&world)), Options::default())
         .map_err(|e| anyhow::anyhow!("the tree does not load in the runtime: {}", e.message))?;
     if let Some((path, scenario)) = faults {
         engine
             .add_faults(scenario)
             .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     }
+    engine.observe(JsonlTrace::default());
     let status = engine.run(100_000, |_| {});
     // The trace's step, fault and record events, in their order.
-    let mut lines = Vec::new();
-    engine.drain_trace(&mut lines)?;
+    let lines = engine
+        .take_observer::<JsonlTrace>()
+        .map(JsonlTrace::into_text)
+        .unwrap_or_default();
+    let lines = lines.as_bytes();
     let mut out = String::new();
     for line in lines.split(|b| *b == b'\n').filter(|l| !l.is_empty()) {
         let mut v: serde_json::Value = serde_json::from_slice(line)?;

@@ -198,8 +198,8 @@ fn loop_options(options: &AgentOptions) -> LoopOptions {
         engine: btc_runtime::Options {
             ticks_per_action: options.run.ticks_per_action,
             ms_per_tick: options.run.ms_per_tick,
-            trace: false,
         },
+        trace: false,
         planner: btc_planner::Options::default(),
         max_replans: options.max_replans,
         max_ticks: options.run.max_ticks,

@@ -6,7 +6,7 @@ use crate::faults::Faults;
 use btc_emit as emit;
 use btc_ir::TreeIr;
 use btc_pddl::state::World;
-use btc_runtime::engine::TraceItem;
+use btc_runtime::engine::{Observer, RunView, TickEvent};
 use btc_runtime::{ActionCall, Engine, FaultOutcome, FaultRecord, Kb, Status, TreeDoc};
 use serde::Serialize;
 use std::sync::Arc;
@@ -226,7 +226,6 @@ impl Tree {
         let opts = btc_runtime::Options {
             ticks_per_action: options.ticks_per_action,
             ms_per_tick: options.ms_per_tick,
-            trace: true,
         };
         let tree_error = |e: btc_runtime::LoadError| crate::faults::load_error(&e, &self.ir.plan);
         let mut engine = Engine::build(&doc, Some(Kb::new(&world)), opts).map_err(tree_error)?;
@@ -245,9 +244,9 @@ impl Tree {
         if let Some(f) = faults {
             engine.add_faults(&f.scenario).map_err(|e| f.error(&e))?;
         }
-        let mut steps = Vec::new();
-        let status = engine.run(options.max_ticks, |e| step_events(&mut e.trace, &mut steps));
-        step_events(&mut engine.trace, &mut steps);
+        engine.observe(StepLog::default());
+        let status = engine.run(options.max_ticks, |_| {});
+        let steps = engine.take_observer::<StepLog>().unwrap_or_default().0;
         let sum = engine.summary(status);
         Ok(RunReport {
             status,
@@ -264,16 +263,19 @@ impl Tree {
     }
 }
 
-/// The step starts and ends of the trace so far, which is then forgotten
-/// (a long run keeps no trace).
-fn step_events(trace: &mut Vec<TraceItem>, out: &mut Vec<StepEvent>) {
-    for t in trace.drain(..) {
-        let (tick, started, step) = match t {
-            TraceItem::StepStarted { tick, step } => (tick, true, step),
-            TraceItem::StepFinished { tick, step } => (tick, false, step),
-            _ => continue,
+/// The observer of a run's step starts and ends (all a report keeps of
+/// its events).
+#[derive(Default)]
+struct StepLog(Vec<StepEvent>);
+
+impl Observer for StepLog {
+    fn observe(&mut self, event: &TickEvent, _: &RunView<'_>) {
+        let (tick, started, step) = match *event {
+            TickEvent::StepStarted { tick, step } => (tick, true, step),
+            TickEvent::StepFinished { tick, step } => (tick, false, step),
+            _ => return,
         };
-        out.push(StepEvent {
+        self.0.push(StepEvent {
             tick,
             started,
             step,

@@ -7,6 +7,8 @@ mod ariac;
 
 use btc_pddl::source::decode;
 use btc_pddl::state::World;
+use btc_runtime::btlog::BtlogRecorder;
+use btc_runtime::observers::{EventLog, JsonlTrace};
 use btc_runtime::{Engine, Kb, Loaded, Options, TreeDoc};
 use libfuzzer_sys::fuzz_target;
 
@@ -33,15 +35,20 @@ fuzz_target!(|data: &[u8]| {
     };
     let world = own.as_ref().unwrap_or(&ariac);
     let kb = Kb::new(world);
-    let opts = Options {
-        trace: true,
-        ..Options::default()
-    };
-    let built = Engine::build(&doc, Some(kb), opts);
+    let built = Engine::build(&doc, Some(kb), Options::default());
     if let Ok(mut e) = built {
-        e.run(200, |e| {
-            let _ = e.drain_trace(&mut std::io::sink());
+        // Every observer btc has renders what it is told of.
+        e.observe(JsonlTrace::default());
+        e.observe(EventLog::default());
+        e.observe(BtlogRecorder::new(10));
+        let status = e.run(200, |e| {
+            if let Some(t) = e.observer_mut::<JsonlTrace>() {
+                let _ = t.drain(&mut std::io::sink());
+            }
         });
+        if let Some(r) = e.take_observer::<BtlogRecorder>() {
+            let _ = r.finish(&doc, &e, status, 0);
+        }
         let _ = e.summary(btc_runtime::Status::Running);
     }
 });

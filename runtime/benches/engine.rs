@@ -90,7 +90,6 @@ fn opts(ticks_per_action: u32) -> Options {
     Options {
         ticks_per_action,
         ms_per_tick: 10,
-        trace: false,
     }
 }
 

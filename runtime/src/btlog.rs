@@ -16,7 +16,7 @@
 //! BT.CPP's `Tree::tickRoot` does, the root goes back to IDLE after the
 //! tick that finished the tree; that change is written too.
 
-use crate::engine::{Engine, Status, TraceItem};
+use crate::engine::{Engine, Observer, RunView, Status, TickEvent};
 use crate::error::LoadError;
 use crate::spec::{default_name, Kind, SNode, TreeDoc, Verdict};
 use btc_ir::{LeafKind, PortDirection, PortValue};
@@ -496,45 +496,70 @@ fn code(s: Status) -> u8 {
     }
 }
 
-/// The `.btlog` of a finished run: `engine` must have run with a trace
-/// (`Options::trace`); `status` is what the run came to; `start_usec` the
-/// wall-clock start (microseconds since the epoch).
-pub fn write(
-    doc: &TreeDoc,
-    engine: &Engine,
-    status: Status,
+/// The Groot2 replay of a run, as BT.CPP's `FileLogger2` makes it: an
+/// observer that keeps each status change as the 9 bytes of its record
+/// (time, node uid, status), and [`BtlogRecorder::finish`] writes the file.
+#[derive(Debug)]
+pub struct BtlogRecorder {
     ms_per_tick: u64,
-    start_usec: i64,
-) -> Result<Vec<u8>, LoadError> {
-    let xml = tree_xml(doc, engine)?;
-    let mut out = Vec::with_capacity(64 + xml.len() + engine.trace.len() * 9);
-    out.extend_from_slice(b"BTCPP4-FileLogger2");
-    out.push(1);
-    let len = i32::try_from(xml.len()).map_err(|_| {
-        LoadError::new(
-            codes::X_BTLOG,
-            "the tree's XML is over 2 GiB: a .btlog cannot hold it",
-        )
-    })?;
-    out.extend_from_slice(&len.to_le_bytes());
-    out.extend_from_slice(xml.as_bytes());
-    out.extend_from_slice(&start_usec.to_le_bytes());
-    let mut record = |tick: u64, node: u32, to: Status| {
-        let usec = tick.saturating_mul(ms_per_tick).saturating_mul(1000);
-        out.extend_from_slice(&usec.to_le_bytes()[..6]);
-        out.extend_from_slice(&((node + 1) as u16).to_le_bytes());
-        out.push(code(to));
-    };
-    for t in &engine.trace {
-        if let TraceItem::Status { tick, node, to, .. } = t {
-            record(*tick, *node, *to);
+    records: Vec<u8>,
+}
+
+impl BtlogRecorder {
+    /// A recorder for an engine that runs `ms_per_tick` simulated
+    /// milliseconds a tick (the replay's clock).
+    pub fn new(ms_per_tick: u64) -> Self {
+        BtlogRecorder {
+            ms_per_tick,
+            records: Vec::new(),
         }
     }
-    if status.is_done() && engine.node_count() > 0 {
-        // Tree::tickRoot's reset of the root after the last tick.
-        record(engine.tick, 0, Status::Idle);
+
+    fn record(&mut self, tick: u64, node: u32, to: Status) {
+        let usec = tick.saturating_mul(self.ms_per_tick).saturating_mul(1000);
+        self.records.extend_from_slice(&usec.to_le_bytes()[..6]);
+        self.records
+            .extend_from_slice(&((node + 1) as u16).to_le_bytes());
+        self.records.push(code(to));
     }
-    Ok(out)
+
+    /// The `.btlog` of the finished run: `status` is what the run came to;
+    /// `start_usec` the wall-clock start (microseconds since the epoch).
+    pub fn finish(
+        mut self,
+        doc: &TreeDoc,
+        engine: &Engine,
+        status: Status,
+        start_usec: i64,
+    ) -> Result<Vec<u8>, LoadError> {
+        let xml = tree_xml(doc, engine)?;
+        let len = i32::try_from(xml.len()).map_err(|_| {
+            LoadError::new(
+                codes::X_BTLOG,
+                "the tree's XML is over 2 GiB: a .btlog cannot hold it",
+            )
+        })?;
+        if status.is_done() && engine.node_count() > 0 {
+            // Tree::tickRoot's reset of the root after the last tick.
+            self.record(engine.tick, 0, Status::Idle);
+        }
+        let mut out = Vec::with_capacity(64 + xml.len() + self.records.len());
+        out.extend_from_slice(b"BTCPP4-FileLogger2");
+        out.push(1);
+        out.extend_from_slice(&len.to_le_bytes());
+        out.extend_from_slice(xml.as_bytes());
+        out.extend_from_slice(&start_usec.to_le_bytes());
+        out.extend_from_slice(&self.records);
+        Ok(out)
+    }
+}
+
+impl Observer for BtlogRecorder {
+    fn observe(&mut self, event: &TickEvent, _: &RunView<'_>) {
+        if let TickEvent::Status { tick, node, to, .. } = *event {
+            self.record(tick, node, to);
+        }
+    }
 }
 
 #[cfg(test)]
@@ -573,13 +598,11 @@ mod tests {
     #[test]
     fn records_are_nine_bytes_after_the_header_the_xml_and_the_start() {
         let d = doc(leaf("AlwaysSuccess"));
-        let opts = Options {
-            trace: true,
-            ..Options::default()
-        };
-        let mut e = Engine::build(&d, None, opts).unwrap();
+        let mut e = Engine::build(&d, None, Options::default()).unwrap();
+        e.observe(BtlogRecorder::new(10));
         let s = e.run(10, |_| {});
-        let b = write(&d, &e, s, 10, 1234).unwrap();
+        let rec = e.take_observer::<BtlogRecorder>().unwrap();
+        let b = rec.finish(&d, &e, s, 1234).unwrap();
         assert_eq!(&b[..19], b"BTCPP4-FileLogger2\x01");
         let n = i32::from_le_bytes(b[19..23].try_into().unwrap()) as usize;
         let xml = std::str::from_utf8(&b[23..23 + n]).unwrap();

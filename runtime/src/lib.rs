@@ -17,6 +17,7 @@ pub mod faults;
 pub mod handler;
 pub mod include;
 pub mod kb;
+pub mod observers;
 pub mod script;
 pub mod spec;
 pub mod xml;

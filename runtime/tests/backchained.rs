@@ -12,8 +12,8 @@ use btc_ir::TreeIr;
 use btc_lang::db::{compile, JobWorld};
 use btc_pddl::logic::Formula;
 use btc_pddl::state::{Key, World};
-use btc_runtime::{Engine, Kb, Status, TreeDoc};
-use common::{corpus_job, traced};
+use btc_runtime::{Engine, Kb, Options, Status, TreeDoc};
+use common::{corpus_job, jsonl, traced};
 
 /// The rules text with its `plan { ... }` block (if any) replaced by
 /// `plan { steps backchained }`.
@@ -42,7 +42,7 @@ fn backchained(rules: &str) -> String {
 
 /// The steps started by a run, 0-based, in order.
 fn started(e: &Engine) -> Vec<usize> {
-    e.trace_jsonl()
+    jsonl(&e)
         .lines()
         .filter_map(|l| serde_json::from_str::<serde_json::Value>(l).ok())
         .filter(|v| v["event"] == "step_started")
@@ -119,7 +119,9 @@ fn backchained_plans_resume_from_every_prefix_and_redo_what_a_lost_fact_needs() 
                 .map(|s| s.index)
                 .collect();
             for k in 0..=run.len() {
-                let mut e = Engine::build(&doc, Some(after(&w, &ir, &run, k)), traced()).unwrap();
+                let mut e = Engine::build(&doc, Some(after(&w, &ir, &run, k)), Options::default())
+                    .map(traced)
+                    .unwrap();
                 let s = e.run(100_000, |_| {});
                 assert_eq!(s, Status::Success, "{what} from step {k}: {:#?}", e.records);
                 assert_eq!(e.summary(s).goal_reached, Some(true), "{what}");
@@ -130,7 +132,9 @@ fn backchained_plans_resume_from_every_prefix_and_redo_what_a_lost_fact_needs() 
                 for (fact, key) in needed(&kb, &ir, &run[k..]) {
                     let mut kb = after(&w, &ir, &run, k);
                     kb.apply_keys(Vec::new(), vec![key]);
-                    let mut e = Engine::build(&doc, Some(kb), traced()).unwrap();
+                    let mut e = Engine::build(&doc, Some(kb), Options::default())
+                        .map(traced)
+                        .unwrap();
                     let s = e.run(100_000, |_| {});
                     let ran = started(&e);
                     deletions += 1;

@@ -13,7 +13,9 @@
 //!
 //! `BTC_CONFORMANCE_CASES` and `BTC_CONFORMANCE_SEED` run other batches.
 
-use btc_runtime::engine::TraceItem;
+use btc_runtime::btlog::BtlogRecorder;
+use btc_runtime::engine::TickEvent;
+use btc_runtime::observers::EventLog;
 use btc_runtime::{xml, Engine, Options, Status};
 use std::collections::HashMap;
 use std::fmt::Write as _;
@@ -64,11 +66,12 @@ fn run_btc(case: &Case) -> Result<Run, String> {
 fn run_btc_logged(case: &Case) -> Result<(Run, Vec<u8>), String> {
     let doc = tree_doc(case)?;
     let opts = Options {
-        trace: true,
         ms_per_tick: case.tick_ms.max(1),
         ..Options::default()
     };
     let mut e = Engine::build(&doc, None, opts).map_err(|e| e.to_string())?;
+    e.observe(EventLog::default());
+    e.observe(BtlogRecorder::new(case.tick_ms.max(1)));
     let mut pos: HashMap<u32, usize> = HashMap::new();
     e.set_action_handler(
         "Scripted",
@@ -100,12 +103,13 @@ fn run_btc_logged(case: &Case) -> Result<(Run, Vec<u8>), String> {
     for _ in 0..case.ticks {
         let s = e.tick_once();
         let mut changes = Vec::new();
-        for t in &e.trace[seen..] {
-            if let TraceItem::Status { node, from, to, .. } = t {
+        let events = &e.observer::<EventLog>().expect("observed").events;
+        for t in &events[seen..] {
+            if let TickEvent::Status { node, from, to, .. } = t {
                 changes.push((*node, letter(*from), letter(*to)));
             }
         }
-        seen = e.trace.len();
+        seen = events.len();
         run.ticks.push(changes);
         run.status = letter(s);
         last = s;
@@ -113,7 +117,10 @@ fn run_btc_logged(case: &Case) -> Result<(Run, Vec<u8>), String> {
             break;
         }
     }
-    let log = btc_runtime::btlog::write(&doc, &e, last, case.tick_ms.max(1), 0)
+    let log = e
+        .take_observer::<BtlogRecorder>()
+        .expect("observed")
+        .finish(&doc, &e, last, 0)
         .map_err(|e| e.to_string())?;
     Ok((run, log))
 }

@@ -2,6 +2,7 @@
 //! order, also under load with a tiny queue; shutdown is clean.
 
 use btc_ir::LeafKind;
+use btc_runtime::observers::EventLog;
 use btc_runtime::spec::{Kind, SNode, TreeDoc};
 use btc_runtime::{Command, Controller, Engine, Options, Status};
 use std::time::Duration;
@@ -159,21 +160,16 @@ fn halted_leaves_commands_still_run_once_and_are_not_waited_for() {
         scripts: Default::default(),
         at: None,
     };
-    let mut e = Engine::build(
-        &doc(root),
-        None,
-        Options {
-            trace: true,
-            ..Options::default()
-        },
-    )
-    .unwrap();
+    let mut e = Engine::build(&doc(root), None, Options::default()).unwrap();
+    e.observe(EventLog::default());
     e.attach_controller(Controller::start(4, Duration::from_millis(20)));
     assert_eq!(e.run(10_000, |_| {}), Status::Success);
     let halted = e
-        .trace
+        .observer::<EventLog>()
+        .unwrap()
+        .events
         .iter()
-        .filter(|t| matches!(t, btc_runtime::engine::TraceItem::Status { node, from: Status::Running, to: Status::Idle, .. } if e.meta[*node as usize].name == "work 0"))
+        .filter(|t| matches!(t, btc_runtime::engine::TickEvent::Status { node, from: Status::Running, to: Status::Idle, .. } if e.meta[*node as usize].name == "work 0"))
         .count();
     assert_eq!(halted, 3);
     let log = e.take_controller().unwrap().shutdown();

@@ -5,8 +5,8 @@
 mod common;
 use btc_lang::db::compile;
 use btc_lang::db::JobWorld;
-use btc_runtime::{xml, Engine, Status, TreeDoc};
-use common::{corpus_job, traced};
+use btc_runtime::{xml, Engine, Options, Status, TreeDoc};
+use common::{corpus_job, jsonl, traced};
 
 #[test]
 fn corpus_plans_run_to_their_goal() {
@@ -28,14 +28,15 @@ fn corpus_plans_run_to_their_goal() {
             let mut traces = Vec::new();
             let from_xml = xml::parse(&xml_text).unwrap().with_actions(jw.domain);
             for doc in [TreeDoc::from_ir(&ir), from_xml] {
-                let mut e = Engine::build(&doc, Some(btc_runtime::Kb::new(&w)), traced())
+                let mut e = Engine::build(&doc, Some(btc_runtime::Kb::new(&w)), Options::default())
+                    .map(traced)
                     .unwrap_or_else(|e| panic!("{what}: {e}"));
                 let s = e.run(1_000_000, |_| {});
                 let sum = e.summary(s);
                 assert_eq!(s, Status::Success, "{what}: {:#?}", sum.records);
                 assert_eq!(sum.goal_reached, Some(true), "{what}");
                 assert_eq!(sum.steps_done, sum.steps_total, "{what}");
-                traces.push(e.trace_jsonl());
+                traces.push(jsonl(&e));
             }
             assert!(traces[0] == traces[1], "{what}: the XML runs differently");
             ran += 1;

@@ -4,8 +4,8 @@
 //! runs the IR and the XML alike (fixture `tests/fixtures/delay_run_once/`).
 
 mod common;
-use btc_runtime::engine::TraceItem;
-use btc_runtime::{Status, TreeDoc};
+use btc_runtime::engine::TickEvent;
+use btc_runtime::{Options, Status, TreeDoc};
 use common::*;
 
 #[test]
@@ -23,16 +23,15 @@ fn delay_and_run_once_round_trip_from_the_rules_to_the_engine() {
     let w = ex.world();
     let mut runs = Vec::new();
     for doc in [TreeDoc::from_ir(&ex.ir), ex.xml(&xml)] {
-        let mut e = ex.engine(&w, &doc, traced());
+        let mut e = traced(ex.engine(&w, &doc, Options::default()));
         let s = e.run(100_000, |_| {});
         assert_eq!(s, Status::Success, "{:#?}", e.records);
         assert_eq!(e.summary(s).goal_reached, Some(true));
-        let steps: Vec<String> = e
-            .trace
+        let steps: Vec<String> = events(&e)
             .iter()
             .filter_map(|t| match t {
-                TraceItem::StepStarted { tick, step } => Some(format!("{tick} start {step}")),
-                TraceItem::StepFinished { tick, step } => Some(format!("{tick} end {step}")),
+                TickEvent::StepStarted { tick, step } => Some(format!("{tick} start {step}")),
+                TickEvent::StepFinished { tick, step } => Some(format!("{tick} end {step}")),
                 _ => None,
             })
             .collect();
@@ -50,7 +49,7 @@ fn a_delay_takes_ticks() {
     let ex = compile_dir(&dir, "delay_run_once");
     let w = ex.world();
     let ticks = |doc: &TreeDoc| {
-        let mut e = ex.engine(&w, doc, traced());
+        let mut e = traced(ex.engine(&w, doc, Options::default()));
         assert_eq!(e.run(100_000, |_| {}), Status::Success);
         e.tick
     };

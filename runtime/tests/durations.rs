@@ -6,9 +6,9 @@
 
 mod common;
 
-use btc_runtime::engine::TraceItem;
-use btc_runtime::TreeDoc;
-use common::{root, traced};
+use btc_runtime::engine::TickEvent;
+use btc_runtime::{Options, TreeDoc};
+use common::{events, root, traced};
 use std::collections::BTreeMap;
 
 /// Each step's (start tick, end tick), 1-based steps.
@@ -20,18 +20,18 @@ fn spans(ticks_per_unit: u32) -> BTreeMap<usize, (u64, u64)> {
         &dir.join("problem.pddl"),
     );
     let w = ex.world();
-    let mut e = ex.engine(&w, &TreeDoc::from_ir(&ex.ir), traced());
+    let mut e = traced(ex.engine(&w, &TreeDoc::from_ir(&ex.ir), Options::default()));
     e.simulate_durations(ticks_per_unit);
     let status = e.run(1_000_000, |_| {});
     assert_eq!(status.name(), "SUCCESS");
     assert!(e.goal().is_none_or(|(ok, _)| ok));
     let mut out = BTreeMap::new();
-    for t in &e.trace {
+    for t in events(&e) {
         match t {
-            TraceItem::StepStarted { tick, step } => {
+            TickEvent::StepStarted { tick, step } => {
                 out.insert(*step as usize + 1, (*tick, 0));
             }
-            TraceItem::StepFinished { tick, step } => {
+            TickEvent::StepFinished { tick, step } => {
                 out.get_mut(&(*step as usize + 1)).expect("started").1 = *tick;
             }
             _ => {}

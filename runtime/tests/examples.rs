@@ -2,7 +2,7 @@
 //! written as BT.CPP XML and loaded back runs exactly like its IR.
 
 mod common;
-use btc_runtime::{Status, TreeDoc};
+use btc_runtime::{Options, Status, TreeDoc};
 use common::*;
 
 #[test]
@@ -10,7 +10,7 @@ fn every_example_reaches_its_goal() {
     for name in EXAMPLES {
         let ex = example(name);
         let w = ex.world();
-        let mut e = ex.engine(&w, &TreeDoc::from_ir(&ex.ir), traced());
+        let mut e = traced(ex.engine(&w, &TreeDoc::from_ir(&ex.ir), Options::default()));
         let s = e.run(100_000, |_| {});
         let sum = e.summary(s);
         assert_eq!(
@@ -18,7 +18,7 @@ fn every_example_reaches_its_goal() {
             Status::Success,
             "{name}: {:#?}\n{}",
             sum.records,
-            e.trace_jsonl()
+            jsonl(&e)
         );
         assert_eq!(sum.goal_reached, Some(true), "{name}");
         // The goal's facts are in the final KB, read directly.
@@ -40,7 +40,7 @@ fn the_initial_kb_does_not_hold_the_goal() {
     for name in EXAMPLES {
         let ex = example(name);
         let w = ex.world();
-        let e = ex.engine(&w, &TreeDoc::from_ir(&ex.ir), traced());
+        let e = traced(ex.engine(&w, &TreeDoc::from_ir(&ex.ir), Options::default()));
         assert_eq!(e.goal().map(|g| g.0), Some(false), "{name}");
     }
 }
@@ -65,15 +65,15 @@ fn btcpp_xml_runs_exactly_like_its_ir() {
             // from the domain's actions, as `btc run --tree` does.
             let from_xml = ex.xml(&text);
             assert!(from_xml.steps.is_empty());
-            let mut a = ex.engine(&w, &from_ir, traced());
-            let mut b = ex.engine(&w, &from_xml, traced());
+            let mut a = traced(ex.engine(&w, &from_ir, Options::default()));
+            let mut b = traced(ex.engine(&w, &from_xml, Options::default()));
             assert_eq!(a.steps_total(), b.steps_total(), "{name}");
             let sa = a.run(100_000, |_| {});
             let sb = b.run(100_000, |_| {});
             assert_eq!(sa, Status::Success, "{name}");
             assert_eq!(sa, sb, "{name}");
             assert_eq!(a.node_count(), b.node_count(), "{name} inline={inline}");
-            let (ta, tb) = (a.trace_jsonl(), b.trace_jsonl());
+            let (ta, tb) = (jsonl(&a), jsonl(&b));
             assert!(ta.lines().count() > 10, "{name}");
             if ta != tb {
                 let d = ta.lines().zip(tb.lines()).position(|(x, y)| x != y);
@@ -103,10 +103,10 @@ fn xml_steps_check_the_domain_preconditions_like_the_ir() {
     let sc = btc_runtime::Scenario::parse(&sc_text).unwrap();
     let mut runs = Vec::new();
     for doc in [TreeDoc::from_ir(&ex.ir), ex.xml(&text)] {
-        let mut e = ex.engine(&w, &doc, traced());
+        let mut e = traced(ex.engine(&w, &doc, Options::default()));
         e.add_faults(&sc).unwrap();
         assert_eq!(e.run(1000, |_| {}), Status::Failure);
-        runs.push((e.trace_jsonl(), e.records.clone()));
+        runs.push((jsonl(&e), e.records.clone()));
     }
     assert!(
         runs[0].1[0].reason.contains("precondition"),

@@ -2,7 +2,7 @@
 //! run here on the ARIAC example with its expected outcome.
 
 mod common;
-use btc_runtime::{FaultKind, Scenario, Status, TreeDoc, Value};
+use btc_runtime::{FaultKind, Options, Scenario, Status, TreeDoc, Value};
 use common::*;
 
 enum Expect {
@@ -53,7 +53,7 @@ fn every_fault_kind_has_a_scenario_with_its_outcome() {
     let ex = example("ariac");
     let w = ex.world();
     let doc = TreeDoc::from_ir(&ex.ir);
-    let mut plain = ex.engine(&w, &doc, traced());
+    let mut plain = traced(ex.engine(&w, &doc, Options::default()));
     let s = plain.run(10_000, |_| {});
     assert_eq!(s, Status::Success);
     let baseline = plain.tick;
@@ -62,11 +62,11 @@ fn every_fault_kind_has_a_scenario_with_its_outcome() {
         let sc = scenario(kind);
         assert_eq!(sc.faults.len(), 1, "{kind:?}");
         assert_eq!(sc.faults[0].kind, kind);
-        let mut e = ex.engine(&w, &doc, traced());
+        let mut e = traced(ex.engine(&w, &doc, Options::default()));
         e.add_faults(&sc).unwrap();
         let s = e.run(10_000, |_| {});
         let sum = e.summary(s);
-        let trace = e.trace_jsonl();
+        let trace = jsonl(&e);
         assert!(trace.contains("\"event\":\"fault_triggered\""), "{kind:?}");
         assert!(
             sum.faults[0].met_at.is_some(),
@@ -119,7 +119,7 @@ fn a_malfunction_is_repaired_after_its_duration() {
     let ex = example("ariac");
     let w = ex.world();
     let doc = TreeDoc::from_ir(&ex.ir);
-    let mut e = ex.engine(&w, &doc, traced());
+    let mut e = traced(ex.engine(&w, &doc, Options::default()));
     e.add_faults(&scenario(FaultKind::RobotMalfunction))
         .unwrap();
     e.run(10_000, |_| {});
@@ -138,14 +138,14 @@ fn a_malfunction_is_repaired_after_its_duration() {
     }
     let kb = e.kb.as_ref().unwrap();
     assert!(kb.state.facts.contains(&key));
-    assert!(e.trace_jsonl().contains("\"event\":\"fault_ended\""));
+    assert!(jsonl(&e).contains("\"event\":\"fault_ended\""));
 }
 
 #[test]
 fn a_blackout_that_fails_conditions_fails_the_monitor() {
     let ex = example("ariac");
     let w = ex.world();
-    let mut e = ex.engine(&w, &TreeDoc::from_ir(&ex.ir), traced());
+    let mut e = traced(ex.engine(&w, &TreeDoc::from_ir(&ex.ir), Options::default()));
     let sc = Scenario::parse(&fixture("faults/blackout_failure.toml")).unwrap();
     e.add_faults(&sc).unwrap();
     let s = e.run(10_000, |_| {});
@@ -170,7 +170,7 @@ fn bad_scenarios_are_refused_with_a_code() {
     // Facts are checked against the problem.
     let ex = example("ariac");
     let w = ex.world();
-    let mut eng = ex.engine(&w, &TreeDoc::from_ir(&ex.ir), traced());
+    let mut eng = traced(ex.engine(&w, &TreeDoc::from_ir(&ex.ir), Options::default()));
     let sc = Scenario::parse(&fixture("faults/unknown_fact.toml")).unwrap();
     let err = eng.add_faults(&sc).unwrap_err();
     assert_eq!(err.code.id, "X006");

@@ -4,7 +4,7 @@
 
 mod common;
 use btc_pddl::logic::Atom;
-use btc_runtime::{Status, TreeDoc};
+use btc_runtime::{Options, Status, TreeDoc};
 use common::*;
 
 #[test]
@@ -37,7 +37,7 @@ fn the_final_kb_shows_the_rules_effect_from_the_ir_and_from_the_xml() {
     );
     let mut finals = Vec::new();
     for doc in [TreeDoc::from_ir(&ex.ir), ex.xml(&xml)] {
-        let mut e = ex.engine(&w, &doc, traced());
+        let mut e = traced(ex.engine(&w, &doc, Options::default()));
         let s = e.run(1000, |_| {});
         assert_eq!(s, Status::Success, "{:#?}", e.records);
         assert_eq!(e.summary(s).goal_reached, Some(true));

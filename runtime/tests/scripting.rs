@@ -5,6 +5,7 @@
 //! values follow BT.CPP 4.10's sources and gtests (`gtest_preconditions`,
 //! `gtest_postconditions`, `gtest_skipping`, `gtest_switch`...).
 
+use btc_runtime::observers::EventLog;
 use btc_runtime::{xml, Engine, LoadError, Options, Status, Value};
 use std::path::Path;
 
@@ -129,18 +130,17 @@ fn a_script_that_fails_at_run_time_fails_its_node_with_the_reason() {
 #[test]
 fn a_skipped_condition_fails_if_then_else_and_while_do_else_with_the_reason() {
     let doc = xml::parse(&fixture("skipped_condition")).unwrap();
-    let opts = Options {
-        trace: true,
-        ..Options::default()
-    };
-    let mut e = Engine::build(&doc, None, opts).unwrap();
+    let mut e = Engine::build(&doc, None, Options::default()).unwrap();
+    e.observe(EventLog::default());
     assert_eq!(e.run(10, |_| {}), Status::Failure);
     assert_eq!(e.tick, 1);
     let failed: Vec<(u32, &str)> = e
-        .trace
+        .observer::<EventLog>()
+        .unwrap()
+        .events
         .iter()
         .filter_map(|t| match t {
-            btc_runtime::engine::TraceItem::Status {
+            btc_runtime::engine::TickEvent::Status {
                 node,
                 to: Status::Failure,
                 ..

@@ -7,7 +7,8 @@ mod common;
 use btc_pddl::logic::decode;
 use btc_pddl::pipeline;
 use btc_pddl::state::World;
-use btc_runtime::engine::TraceItem;
+use btc_runtime::engine::TickEvent;
+use btc_runtime::observers::EventLog;
 use btc_runtime::{xml, Engine, Kb, Options, Status, Value};
 use common::fixture;
 use Status::*;
@@ -42,9 +43,10 @@ fn engine<'a>(w: &'a Flags, tree: &str, ticks_per_action: u32) -> Engine<'a> {
     let opts = Options {
         ticks_per_action,
         ms_per_tick: 10,
-        trace: true,
     };
-    Engine::build(&doc, Some(kb), opts).unwrap_or_else(|e| panic!("{tree}: {e}"))
+    let mut e = Engine::build(&doc, Some(kb), opts).unwrap_or_else(|e| panic!("{tree}: {e}"));
+    e.observe(EventLog::default());
+    e
 }
 
 fn set(e: &mut Engine, fact: &str, on: bool) {
@@ -70,10 +72,12 @@ fn ticks(e: &mut Engine, n: usize) -> Vec<Status> {
 }
 
 fn transitions(e: &Engine, name: &str, from: Option<Status>, to: Option<Status>) -> usize {
-    e.trace
+    e.observer::<EventLog>()
+        .expect("observed")
+        .events
         .iter()
         .filter(|t| match t {
-            TraceItem::Status {
+            TickEvent::Status {
                 node,
                 from: f,
                 to: t,

@@ -15,9 +15,9 @@
 mod common;
 
 use btc_emit::pytrees::{self, PyOptions, Runtime};
-use btc_runtime::engine::TraceItem;
-use btc_runtime::{Engine, TreeDoc};
-use common::{root, traced, Example};
+use btc_runtime::engine::TickEvent;
+use btc_runtime::{Engine, Options, TreeDoc};
+use common::{events, root, traced, Example};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -42,14 +42,13 @@ struct Outcome {
 
 fn engine_outcome(mut e: Engine<'_>) -> Outcome {
     let status = e.run(MAX_TICKS, |_| {});
-    let events = e
-        .trace
+    let events = events(&e)
         .iter()
         .filter_map(|t| match t {
-            TraceItem::StepStarted { tick, step } => {
+            TickEvent::StepStarted { tick, step } => {
                 Some((*tick, "start".to_owned(), *step as usize + 1))
             }
-            TraceItem::StepFinished { tick, step } => {
+            TickEvent::StepFinished { tick, step } => {
                 Some((*tick, "end".to_owned(), *step as usize + 1))
             }
             _ => None,
@@ -102,14 +101,18 @@ fn pytrees_outcome(ex: &Example, name: &str) -> Outcome {
 /// Runs `ex` three ways (four: XML in both modes) and compares.
 fn three_ways(ex: &Example, name: &str) -> Outcome {
     let w = ex.world();
-    let from_ir = engine_outcome(ex.engine(&w, &TreeDoc::from_ir(&ex.ir), traced()));
+    let from_ir = engine_outcome(traced(ex.engine(
+        &w,
+        &TreeDoc::from_ir(&ex.ir),
+        Options::default(),
+    )));
     assert!(
         !from_ir.events.is_empty() || ex.ir.steps.iter().all(|s| s.skipped),
         "{name}: no step ran"
     );
     for inline in [false, true] {
         let xml = btc_emit::btcpp::emit(&ex.ir, inline);
-        let from_xml = engine_outcome(ex.engine(&w, &ex.xml(&xml), traced()));
+        let from_xml = engine_outcome(traced(ex.engine(&w, &ex.xml(&xml), Options::default())));
         assert_eq!(
             from_ir, from_xml,
             "{name}: IR and XML (inline={inline}) differ"

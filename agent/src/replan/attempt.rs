@@ -9,6 +9,7 @@ use btc_lang::db;
 use btc_pddl::logic::Formula;
 use btc_runtime::engine::{Engine, FaultRecord, Status};
 use btc_runtime::faults::FaultKind;
+use btc_runtime::observers::JsonlTrace;
 use btc_runtime::{Kb, TreeDoc};
 use std::time::Instant;
 
@@ -140,7 +141,7 @@ impl Run<'_, '_> {
         let compile_ms = tc.elapsed().as_secs_f64() * 1e3;
         let plan: Vec<String> = ir.steps.iter().map(|s| s.display()).collect();
         let goal_text = goal.to_string();
-        let trace = self.opts.engine.trace;
+        let trace = self.opts.trace;
         if trace {
             push_event(
                 self.trace_out,
@@ -175,7 +176,7 @@ impl Run<'_, '_> {
         goal: &Formula,
         doc: &TreeDoc,
     ) -> Result<Ran, LoopError> {
-        let trace = self.opts.engine.trace;
+        let trace = self.opts.trace;
         // Run, in the carried world.
         let mut kb = self.carry.kb(&self.world);
         let g = goal_formula(&mut kb, goal)?;
@@ -183,6 +184,9 @@ impl Run<'_, '_> {
         let mut engine =
             Engine::build(doc, Some(kb), self.opts.engine.clone()).map_err(LoopError::Tree)?;
         self.execution.install(&mut engine);
+        if trace {
+            engine.observe(JsonlTrace::default());
+        }
         engine.tick = self.carry.tick;
         match self.carry.faults.take() {
             Some(f) => engine.restore_faults(f),
@@ -197,8 +201,8 @@ impl Run<'_, '_> {
         let trace_out = &mut *self.trace_out;
         // A high-priority order whose goal does not hold preempts the plan.
         let (status, preempted) = engine.run_until(self.opts.max_ticks, |e| {
-            if trace {
-                let _ = e.drain_trace(trace_out);
+            if let Some(t) = e.observer_mut::<JsonlTrace>() {
+                let _ = t.drain(trace_out);
             }
             e.kb.as_ref()
                 .is_some_and(|kb| !kb.unmet_extra_goals().is_empty())
@@ -228,8 +232,8 @@ impl Run<'_, '_> {
             .map(|f| f.fault.clone())
             .collect();
         self.out.faults = engine.fault_outcomes(done);
-        if trace {
-            let _ = engine.drain_trace(self.trace_out);
+        if let Some(t) = engine.observer_mut::<JsonlTrace>() {
+            let _ = t.drain(self.trace_out);
         }
         let discarded = engine.discarded_parts();
         let kb = engine.kb.as_mut().expect("built with a KB");

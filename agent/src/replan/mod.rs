@@ -38,6 +38,9 @@ use std::time::Instant;
 #[derive(Clone, Debug)]
 pub struct LoopOptions {
     pub engine: Options,
+    /// Write the loop's trace: each attempt's events and the loop's own
+    /// (plans, replans, the goal check), as JSON Lines.
+    pub trace: bool,
     pub planner: btc_planner::Options,
     /// Plans made after a failure, at most (the first plan does not count).
     pub max_replans: usize,
@@ -49,6 +52,7 @@ impl Default for LoopOptions {
     fn default() -> Self {
         LoopOptions {
             engine: Options::default(),
+            trace: false,
             planner: btc_planner::Options::default(),
             max_replans: 5,
             max_ticks: 100_000,
@@ -124,7 +128,7 @@ pub struct LoopSummary {
     #[serde(skip)]
     pub diagnostics: Vec<Diagnostic>,
     /// Every attempt's trace and the loop's events, as JSON Lines (when
-    /// `engine.trace` is set).
+    /// `trace` is set).
     #[serde(skip)]
     pub trace: String,
 }
@@ -169,7 +173,7 @@ pub fn run_loop(
     Ok(out)
 }
 
-/// [`run_loop`] with the trace (when `opts.engine.trace` is set) written to
+/// [`run_loop`] with the trace (when `opts.trace` is set) written to
 /// `trace` as it happens, tick by tick, instead of kept in the summary: a
 /// long loop holds bounded memory and a killed one leaves its trace so far.
 /// Write errors are the writer's to keep (`btc_files::Stream` does).
@@ -262,7 +266,7 @@ fn run_loop_on(
     let mut out = run.out;
     out.goal = run.carry.goal(&run.base_goal).to_string();
     out.elapsed_ms = t0.elapsed().as_secs_f64() * 1e3;
-    if opts.engine.trace {
+    if opts.trace {
         push_event(
             run.trace_out,
             serde_json::json!({
@@ -332,7 +336,7 @@ impl Run<'_, '_> {
                 return Ok(());
             }
             let rp = self.replan(attempt, &goal, ran);
-            if self.opts.engine.trace {
+            if self.opts.trace {
                 let mut v = serde_json::to_value(&rp).unwrap_or_default();
                 if let Some(o) = v.as_object_mut() {
                     o.insert("event".into(), "replan".into());

@@ -16,6 +16,7 @@ use btc_lang::db;
 use btc_pddl::source::Span;
 use btc_pddl::state::Key;
 use btc_planner::Outcome;
+use btc_runtime::observers::JsonlTrace;
 use btc_runtime::{Engine, Kb, Options, Scenario, Status, TreeDoc};
 use std::time::Instant;
 
@@ -155,7 +156,6 @@ impl<'w> Sim<'w, '_> {
         let eopts = Options {
             ticks_per_action: time.ticks_per_action,
             ms_per_tick: (time.seconds_per_tick * 1000.0).round().max(1.0) as u64,
-            trace: self.opts.trace,
         };
         let mut engine = match Engine::build(&doc, Some(kb), eopts) {
             Ok(e) => e,
@@ -164,6 +164,9 @@ impl<'w> Sim<'w, '_> {
                 return self.attempt_failed(t, attempt, None);
             }
         };
+        if self.opts.trace {
+            engine.observe(JsonlTrace::default());
+        }
         engine.tick = self.tick - 1;
         // Challenges in effect reach the new tree too.
         let specs = self.faults_for(robot, self.tick);
@@ -276,7 +279,7 @@ impl<'w> Sim<'w, '_> {
         }
     }
 
-    fn finish_attempt(&mut self, a: usize, engine: Engine<'w>, ok: bool) {
+    fn finish_attempt(&mut self, a: usize, mut engine: Engine<'w>, ok: bool) {
         let Some(t) = self.agents[a].task else {
             return;
         };
@@ -286,9 +289,8 @@ impl<'w> Sim<'w, '_> {
             .expect("a running task has an attempt");
         attempt.end_tick = self.tick;
         let record = engine.records.last().cloned();
-        if self.trace.is_on() {
-            self.trace
-                .tree(&engine.trace_jsonl(), &attempt.agent, t, self.tick);
+        if let Some(tree) = engine.take_observer::<JsonlTrace>() {
+            self.trace.tree(tree.text(), &attempt.agent, t, self.tick);
         }
         let faults: Vec<String> = record
             .as_ref()

@@ -64,7 +64,7 @@ impl<'w> Engine<'w> {
             opts,
             tick: 0,
             now_ms: 0,
-            trace: Vec::new(),
+            observers: Vec::new(),
             last_failure: None,
             records: Vec::new(),
             faults: Vec::new(),

@@ -6,7 +6,7 @@
 //! data in [`crate::faults`].
 
 use super::record::Reason;
-use super::{Engine, Status, TraceItem};
+use super::{Engine, Status, TickEvent};
 use crate::error::LoadError;
 use crate::faults::{bad, Blackout, FaultKind, FaultOutcome, FaultRt, Scenario, Trigger};
 use btc_pddl::logic::Atom;
@@ -85,8 +85,8 @@ impl<'w> Engine<'w> {
         let tick = self.tick;
         let spec = self.faults[f].spec.clone();
         self.faults[f].met_at = Some(tick);
-        if self.opts.trace {
-            self.trace.push(TraceItem::Fault {
+        if self.observed() {
+            self.notify(TickEvent::Fault {
                 tick,
                 fault: f,
                 ended: false,
@@ -136,8 +136,8 @@ impl<'w> Engine<'w> {
             rt.removed = add;
             rt.added = del;
         }
-        if self.opts.trace {
-            self.trace.push(TraceItem::Fault {
+        if self.observed() {
+            self.notify(TickEvent::Fault {
                 tick: self.tick,
                 fault: f,
                 ended: true,
@@ -148,8 +148,7 @@ impl<'w> Engine<'w> {
 
     /// Takes the faults' run-time state out of the engine (which keeps no
     /// faults): replanning moves it to the next plan's engine, so a fault
-    /// that fired does not fire again. Call after [`Engine::trace_jsonl`]:
-    /// the trace names faults by their place in this list.
+    /// that fired does not fire again.
     pub fn take_faults(&mut self) -> Vec<FaultRt> {
         let v = std::mem::take(&mut self.faults);
         self.refresh_live();

@@ -5,7 +5,7 @@
 use super::record::Reason;
 use super::state::NodeState;
 use super::step::StepRt;
-use super::{Engine, Src, Status, TraceItem, Value};
+use super::{Engine, Src, Status, TickEvent, Value};
 use crate::controller::Command;
 use crate::kb::{EffectId, FormulaId};
 
@@ -176,8 +176,8 @@ impl<'w> Engine<'w> {
         if self.controller.is_some() {
             let cmd = self.command(i, a);
             let seq = self.controller.as_mut().map_or(0, |c| c.submit(cmd));
-            if self.opts.trace {
-                self.trace.push(TraceItem::Command {
+            if self.observed() {
+                self.notify(TickEvent::Command {
                     tick: self.tick,
                     seq,
                     node: i,

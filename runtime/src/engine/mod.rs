@@ -8,8 +8,8 @@
 //! The parts: `build` compiles a [`TreeDoc`](crate::spec::TreeDoc) into the
 //! arena; `control`, `decorator`, `leaf` and `step` are the tick semantics
 //! of each family of nodes; `record` is why nodes fail and the fault
-//! records; the tick's observers and hooks are `trace` (status changes and
-//! events), `faults` (injected faults: before a tick, when a step or an
+//! records; the tick's observers and hooks are `observe` (status changes
+//! and events go to the caller's observers), `faults` (injected faults: before a tick, when a step or an
 //! action starts, when a condition is read) and the controller (commands
 //! of action leaves).
 
@@ -20,15 +20,15 @@ mod faults;
 mod flow;
 mod guard;
 mod leaf;
+mod observe;
 mod record;
 mod state;
 mod step;
-mod trace;
 mod value;
 
+pub use observe::{Observer, RunView, TickEvent};
 pub use record::FaultRecord;
 pub(crate) use record::Reason;
-pub use trace::TraceItem;
 pub use value::Value;
 
 use crate::controller::Controller;
@@ -197,8 +197,6 @@ pub struct Options {
     pub ticks_per_action: u32,
     /// Simulated milliseconds per tick (`Sleep`, `Timeout`).
     pub ms_per_tick: u64,
-    /// Record every status change.
-    pub trace: bool,
 }
 
 impl Default for Options {
@@ -206,7 +204,6 @@ impl Default for Options {
         Options {
             ticks_per_action: 1,
             ms_per_tick: 10,
-            trace: false,
         }
     }
 }
@@ -231,7 +228,8 @@ pub struct Engine<'w> {
     pub(crate) opts: Options,
     pub tick: u64,
     pub(crate) now_ms: u64,
-    pub trace: Vec<TraceItem>,
+    /// Told of every event ([`Engine::observe`]).
+    pub(crate) observers: Vec<Box<dyn Observer>>,
     pub(crate) last_failure: Option<(u32, Reason)>,
     pub records: Vec<FaultRecord>,
     pub(crate) faults: Vec<FaultRt>,
@@ -395,13 +393,13 @@ impl<'w> Engine<'w> {
         self.kids[(def.first + j) as usize]
     }
 
-    /// A node's status changes; the trace observes it.
+    /// A node's status changes; the observers are told.
     #[inline]
     pub(crate) fn set(&mut self, i: usize, s: Status) {
         let old = self.status[i];
         if old != s {
             self.status[i] = s;
-            if self.opts.trace {
+            if self.observed() {
                 self.observe_status(i as u32, old, s);
             }
         }

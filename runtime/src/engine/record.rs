@@ -2,7 +2,7 @@
 //! the goal that does not hold), written to the records, the blackboard
 //! (`fault_node`, `fault_step`, `fault_reason`, `fault_kb`) and the trace.
 
-use super::{Engine, Status, TraceItem, Value};
+use super::{Engine, Status, TickEvent, Value};
 use crate::kb::{ConditionId, FormulaId, Kb};
 use serde::Serialize;
 
@@ -105,8 +105,8 @@ impl<'w> Engine<'w> {
         self.bb[kb as usize] = Value::Text(rec.kb.join(" ").into());
         self.bb_gen += 1;
         self.records.push(rec);
-        if self.opts.trace {
-            self.trace.push(TraceItem::Record(self.records.len() - 1));
+        if self.observed() {
+            self.notify(TickEvent::Record(self.records.len() - 1));
         }
     }
 

@@ -5,7 +5,7 @@
 //! duration in ticks has passed since it started.
 
 use super::record::Reason;
-use super::{Engine, NodeDef, Status, TraceItem};
+use super::{Engine, NodeDef, Status, TickEvent};
 use crate::kb::{EffectId, FormulaId};
 
 /// A plan step at run time.
@@ -71,8 +71,8 @@ impl<'w> Engine<'w> {
                 st.started_tick = self.tick;
                 st.holding = false;
             }
-            if self.opts.trace {
-                self.trace.push(TraceItem::StepStarted {
+            if self.observed() {
+                self.notify(TickEvent::StepStarted {
                     tick: self.tick,
                     step: k,
                 });
@@ -130,8 +130,8 @@ impl<'w> Engine<'w> {
             if let (Some(e), Some(kb)) = (eff, self.kb.as_mut()) {
                 kb.apply(e);
             }
-            if self.opts.trace {
-                self.trace.push(TraceItem::StepFinished {
+            if self.observed() {
+                self.notify(TickEvent::StepFinished {
                     tick: self.tick,
                     step: k,
                 });

@@ -6,6 +6,8 @@ use btc_ir::TreeIr;
 use btc_lang::db::JobWorld;
 use btc_lang::db::{self, CompileJob, Database};
 use btc_pddl::state::World;
+use btc_runtime::engine::TickEvent;
+use btc_runtime::observers::{EventLog, JsonlTrace};
 use btc_runtime::{Engine, Options, TreeDoc};
 use std::path::{Path, PathBuf};
 
@@ -136,9 +138,25 @@ impl Example {
     }
 }
 
-pub fn traced() -> Options {
-    Options {
-        trace: true,
-        ..Options::default()
-    }
+/// The engine with a log of its events and its JSON Lines trace
+/// registered ([`events`], [`jsonl`] read them).
+pub fn traced(mut e: Engine<'_>) -> Engine<'_> {
+    e.observe(EventLog::default());
+    e.observe(JsonlTrace::default());
+    e
+}
+
+/// The events of a [`traced`] engine so far.
+pub fn events<'e>(e: &'e Engine<'_>) -> &'e [TickEvent] {
+    &e.observer::<EventLog>()
+        .expect("the engine is traced")
+        .events
+}
+
+/// The JSON Lines trace of a [`traced`] engine so far.
+pub fn jsonl(e: &Engine<'_>) -> String {
+    e.observer::<JsonlTrace>()
+        .expect("the engine is traced")
+        .text()
+        .to_owned()
 }
