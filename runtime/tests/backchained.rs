@@ -42,7 +42,7 @@ fn backchained(rules: &str) -> String {
 
 /// The steps started by a run, 0-based, in order.
 fn started(e: &Engine) -> Vec<usize> {
-    jsonl(&e)
+    jsonl(e)
         .lines()
         .filter_map(|l| serde_json::from_str::<serde_json::Value>(l).ok())
         .filter(|v| v["event"] == "step_started")
