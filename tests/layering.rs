@@ -123,14 +123,6 @@ fn each_crate_depends_only_on_the_layers_below_it() {
     }
 }
 
-/// Module cycles between files (known, and being removed elsewhere), as
-/// the files of one cycle, sorted. A new cycle fails the test below; one
-/// listed here that is gone fails it too, so the list only shrinks.
-const KNOWN_FILE_CYCLES: &[&[&str]] = &[
-    // The engine and the embedder's leaves (issue 25: the engine observed).
-    &["runtime/src/engine/mod.rs", "runtime/src/handler.rs"],
-];
-
 /// A crate's source files as modules: each file's module path
 /// (`rules/check/mod.rs` is `rules::check`), from the crate's root file.
 fn module_files(root: &Path) -> BTreeMap<Vec<String>, PathBuf> {
@@ -410,14 +402,5 @@ fn no_import_cycle_between_the_files_of_a_crate() {
     }
     found.sort();
     found.dedup();
-    let known: Vec<Vec<String>> = KNOWN_FILE_CYCLES
-        .iter()
-        .map(|c| c.iter().map(|s| s.to_string()).collect())
-        .collect();
-    let new: Vec<&Vec<String>> = found.iter().filter(|c| !known.contains(c)).collect();
-    let gone: Vec<&Vec<String>> = known.iter().filter(|c| !found.contains(c)).collect();
-    assert!(
-        new.is_empty() && gone.is_empty(),
-        "import cycles between files: new {new:#?}; listed in KNOWN_FILE_CYCLES but gone {gone:#?}"
-    );
+    assert!(found.is_empty(), "import cycles between files: {found:#?}");
 }

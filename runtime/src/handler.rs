@@ -3,7 +3,9 @@
 //! leaf of that ID. btc's tests implement scripted leaves this way to run
 //! the same trees in btc's engine and in BehaviorTree.CPP.
 
-use crate::engine::{Engine, PortBind, Src, Status, Value};
+use crate::engine::port::{PortBind, Src};
+use crate::engine::status::Status;
+use crate::engine::value::Value;
 
 /// What a handler sees of the leaf it ticks.
 pub struct ActionCall<'a> {
@@ -15,7 +17,7 @@ pub struct ActionCall<'a> {
     pub(crate) ports: &'a [PortBind],
     pub(crate) bb: &'a [Value],
     /// Why the leaf failed, when its implementation says so.
-    reason: std::cell::RefCell<Option<String>>,
+    pub(crate) reason: std::cell::RefCell<Option<String>>,
 }
 
 impl ActionCall<'_> {
@@ -44,42 +46,3 @@ impl ActionCall<'_> {
 /// A leaf implementation: returns the leaf's status for this tick. Halting
 /// a RUNNING leaf resets it to IDLE without calling the handler.
 pub type ActionHandler<'w> = Box<dyn FnMut(&ActionCall<'_>) -> Status + 'w>;
-
-impl<'w> Engine<'w> {
-    /// Makes `handler` tick every action leaf with this ID; returns how
-    /// many leaves it took over.
-    pub fn set_action_handler(&mut self, id: &str, handler: ActionHandler<'w>) -> usize {
-        let h = self.handlers.len() as u32;
-        self.handlers.push(handler);
-        let mut n = 0;
-        for a in &mut self.actions {
-            if &*a.id == id {
-                a.handler = Some(h);
-                n += 1;
-            }
-        }
-        n
-    }
-
-    pub(crate) fn tick_handled(&mut self, i: u32, a: u32, h: u32) -> Status {
-        let (p, q) = self.actions[a as usize].ports;
-        let call = ActionCall {
-            node: i,
-            starting: self.status[i as usize] != Status::Running,
-            ports: &self.ports[p as usize..q as usize],
-            bb: &self.bb,
-            reason: Default::default(),
-        };
-        let status = (self.handlers[h as usize])(&call);
-        if status == Status::Failure {
-            let why = call.reason.into_inner().unwrap_or_else(|| {
-                format!(
-                    "the `{}` leaf's implementation returned FAILURE",
-                    self.actions[a as usize].id
-                )
-            });
-            self.note_failure(i, crate::engine::Reason::Plain(why));
-        }
-        status
-    }
-}

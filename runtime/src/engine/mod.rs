@@ -19,20 +19,26 @@ mod decorator;
 mod faults;
 mod flow;
 mod guard;
+mod handled;
 mod leaf;
 mod observe;
+pub(crate) mod port;
 mod record;
 mod state;
+pub(crate) mod status;
 mod step;
-mod value;
+pub(crate) mod value;
 
 pub use observe::{Observer, RunView, TickEvent};
+pub(crate) use port::{PortBind, Src};
 pub use record::FaultRecord;
 pub(crate) use record::Reason;
+pub use status::Status;
 pub use value::Value;
 
 use crate::controller::Controller;
 use crate::faults::FaultRt;
+use crate::handler::ActionHandler;
 use crate::kb::{ConditionId, EffectId, FormulaId, Kb};
 use serde::Serialize;
 use state::NodeState;
@@ -42,34 +48,6 @@ use step::StepRt;
 pub const MAX_DEPTH: usize = 256;
 /// Deepest chain of SubTree calls.
 pub const MAX_CALLS: usize = 32;
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
-#[serde(rename_all = "UPPERCASE")]
-pub enum Status {
-    Idle,
-    Running,
-    Success,
-    Failure,
-    /// BT.CPP's SKIPPED: the node did not run (a precondition said so).
-    /// Returned to the parent; the node itself stays as it was.
-    Skipped,
-}
-
-impl Status {
-    pub fn name(self) -> &'static str {
-        match self {
-            Status::Idle => "IDLE",
-            Status::Running => "RUNNING",
-            Status::Success => "SUCCESS",
-            Status::Failure => "FAILURE",
-            Status::Skipped => "SKIPPED",
-        }
-    }
-
-    pub fn is_done(self) -> bool {
-        matches!(self, Status::Success | Status::Failure)
-    }
-}
 
 /// What a node of the arena does, with what it was built with.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -158,19 +136,6 @@ pub struct NodeMeta {
     pub parent: Option<u32>,
 }
 
-/// Where a port's value comes from.
-#[derive(Clone, Debug)]
-pub(crate) enum Src {
-    Const(Value),
-    Slot(u32),
-}
-
-#[derive(Clone, Debug)]
-pub(crate) struct PortBind {
-    pub name: Box<str>,
-    pub src: Src,
-}
-
 pub(crate) struct ActionInfo {
     pub id: Box<str>,
     pub ports: (u32, u32),
@@ -236,7 +201,7 @@ pub struct Engine<'w> {
     /// Some fault is pending or in effect: leaves consult the faults.
     pub(crate) faults_live: bool,
     pub(crate) controller: Option<Controller>,
-    pub(crate) handlers: Vec<crate::handler::ActionHandler<'w>>,
+    pub(crate) handlers: Vec<ActionHandler<'w>>,
     pub(crate) record_slots: [u32; 4],
     /// The step that started last, while it has not finished.
     pub(crate) step_running: Option<u32>,
