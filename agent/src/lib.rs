@@ -7,6 +7,7 @@
 //! nothing of planning or of the rules database.
 
 pub mod cell;
+pub mod execution;
 pub mod matrix;
 pub mod random;
 pub mod replan;

@@ -5,9 +5,9 @@
 use super::carry::{goal_formula, Carry};
 use super::planning::Planned;
 use super::{push_event, Attempt, LoopError, LoopSummary, Run};
-use btc_lang::db;
+use crate::execution;
 use btc_pddl::logic::Formula;
-use btc_runtime::engine::{Engine, FaultRecord, Status};
+use btc_runtime::engine::{FaultRecord, Status};
 use btc_runtime::faults::FaultKind;
 use btc_runtime::observers::JsonlTrace;
 use btc_runtime::{Kb, TreeDoc};
@@ -114,30 +114,14 @@ impl Run<'_, '_> {
         planned: Planned,
         for_priority: bool,
     ) -> Result<Ran, LoopError> {
-        let (planned_text, planning_ms, expanded) = match planned {
-            Planned::Made { text, ms, expanded } => (Some(text), ms, expanded),
+        let (made, planning_ms, expanded) = match planned {
+            Planned::Made { plan, ms, expanded } => (Some(plan), ms, expanded),
             _ => (None, 0.0, 0),
         };
-        let source = if planned_text.is_some() {
-            "planned"
-        } else {
-            "given"
-        };
-        if let Some(text) = planned_text {
-            self.db.set_file(&self.plan_path, text);
-        }
+        let source = if made.is_some() { "planned" } else { "given" };
         let tc = Instant::now();
-        let ir = db::compile(self.db, self.job).clone().map_err(|e| {
-            let mut e = e.clone();
-            if e.is_empty() {
-                e = db::job_diagnostics(self.db, self.job)
-                    .iter()
-                    .filter(|d| d.is_error())
-                    .cloned()
-                    .collect();
-            }
-            LoopError::Compile(e)
-        })?;
+        let ir = execution::compile(self.db, self.job, &self.plan_path, made.as_ref())
+            .map_err(LoopError::Compile)?;
         let compile_ms = tc.elapsed().as_secs_f64() * 1e3;
         let plan: Vec<String> = ir.steps.iter().map(|s| s.display()).collect();
         let goal_text = goal.to_string();
@@ -182,12 +166,9 @@ impl Run<'_, '_> {
         let g = goal_formula(&mut kb, goal)?;
         kb.set_goal(g);
         let mut engine =
-            Engine::build(doc, Some(kb), self.opts.engine.clone()).map_err(LoopError::Tree)?;
+            execution::start(doc, kb, self.opts.engine.clone(), self.carry.tick, trace)
+                .map_err(LoopError::Tree)?;
         self.execution.install(&mut engine);
-        if trace {
-            engine.observe(JsonlTrace::default());
-        }
-        engine.tick = self.carry.tick;
         match self.carry.faults.take() {
             Some(f) => engine.restore_faults(f),
             None => {

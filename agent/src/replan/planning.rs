@@ -3,21 +3,20 @@
 
 use super::carry::{goal_formula, Carry};
 use super::{quoted, world, LoopError, LoopOptions, LoopSummary, Run, Unreachable};
+use crate::execution::{self, MadePlan, Planning, PlanningWorld};
 use btc_lang::db::JobWorld;
 use btc_pddl::diagnostic::codes;
 use btc_pddl::logic::Formula;
 use btc_pddl::source::Span;
-use btc_planner::Outcome;
 use btc_runtime::Kb;
-use std::time::Instant;
 
 /// What planning an attempt came to.
 pub(super) enum Planned {
     /// The first attempt runs the given plan file.
     Given,
-    /// A new plan, as sas_plan text.
+    /// A new plan.
     Made {
-        text: String,
+        plan: MadePlan,
         ms: f64,
         expanded: usize,
     },
@@ -51,24 +50,17 @@ impl Run<'_, '_> {
                 Planned::GoalHolds
             });
         }
-        let tp = Instant::now();
-        let report = btc_planner::plan_from(
-            w.domain,
-            w.dix,
-            w.pix,
+        let planning = execution::plan(
+            PlanningWorld::from(&w),
             &kb.state,
-            Some(&goal.to_ast(self.goal_span)),
+            goal,
+            self.goal_span,
             &self.opts.planner,
         )
         .map_err(LoopError::Compile)?;
-        let ms = tp.elapsed().as_secs_f64() * 1e3;
-        match report.outcome {
-            Outcome::Plan(p) => Ok(Planned::Made {
-                text: btc_planner::to_sas_plan(w.domain, w.pix, &p),
-                ms,
-                expanded: report.search.expanded,
-            }),
-            Outcome::Unsolvable => {
+        match planning {
+            Planning::Made { plan, ms, expanded } => Ok(Planned::Made { plan, ms, expanded }),
+            Planning::Unsolvable { .. } => {
                 let un = unreachable(&w, &kb, goal, self.goal_span, &self.carry, self.opts)?;
                 let msg = unsolvable_message(&un, &self.carry, self.out.attempts.is_empty());
                 self.out.stop(
@@ -83,7 +75,7 @@ impl Run<'_, '_> {
                 self.out.goal_failure = kb.goal().1;
                 Ok(Planned::Stopped)
             }
-            Outcome::Timeout => {
+            Planning::Timeout { .. } => {
                 let limit = self.opts.planner.timeout.unwrap_or_default();
                 let msg = format!(
                     "planning from the state at tick {} found no plan within {} s",
@@ -175,16 +167,9 @@ fn unreachable(
     let faults = carry.faults.as_deref().unwrap_or(&[]);
     let mut out = Vec::new();
     for lit in literals {
-        let r = btc_planner::plan_from(
-            w.domain,
-            w.dix,
-            w.pix,
-            &kb.state,
-            Some(&lit.to_ast(span)),
-            &opts.planner,
-        )
-        .map_err(LoopError::Compile)?;
-        if r.outcome == Outcome::Unsolvable {
+        let r = execution::plan(PlanningWorld::from(w), &kb.state, &lit, span, &opts.planner)
+            .map_err(LoopError::Compile)?;
+        if matches!(r, Planning::Unsolvable { .. }) {
             out.push(Unreachable {
                 literal: lit.to_string(),
                 faults: btc_runtime::faults::naming(faults, &lit),

@@ -12,13 +12,11 @@ use super::events::{Cause, Event};
 use super::model::Sim;
 use super::tasks::{Attempt, PartId, Resource, TaskId, TaskState};
 use crate::cell::{conjunction, Literal, Var};
-use btc_lang::db;
+use crate::execution::{self, Planning, PlanningWorld};
 use btc_pddl::source::Span;
 use btc_pddl::state::Key;
-use btc_planner::Outcome;
 use btc_runtime::observers::JsonlTrace;
 use btc_runtime::{Engine, Kb, Options, Scenario, Status, TreeDoc};
-use std::time::Instant;
 
 impl<'w> Sim<'w, '_> {
     /// Plans, compiles and builds the tree of a task on agent `a`.
@@ -89,35 +87,35 @@ impl<'w> Sim<'w, '_> {
         state.facts.retain(|k| {
             !(self.w.facts.kit_free.is(k) || self.w.facts.insert_free.is(k)) || keep.contains(k)
         });
-        let tp = Instant::now();
         let domain = self.cell.domain.domain.as_ref().expect("checked");
-        let report = btc_planner::plan_from(
+        let w = PlanningWorld {
             domain,
-            &self.cell.domain.index,
-            &self.pu.index,
-            &state,
-            Some(&goal_f.to_ast(Span::new(0, 0, 0))),
-            &self.opts.planner,
-        );
-        let ms = tp.elapsed().as_secs_f64() * 1e3;
+            dix: &self.cell.domain.index,
+            pix: &self.pu.index,
+        };
+        let planning = execution::plan(w, &state, &goal_f, Span::new(0, 0, 0), &self.opts.planner);
+        let ms = match &planning {
+            Ok(
+                Planning::Made { ms, .. } | Planning::Unsolvable { ms } | Planning::Timeout { ms },
+            ) => *ms,
+            Err(_) => 0.0,
+        };
         attempt.planning_ms = ms;
         self.agents[a].plans += 1;
         self.agents[a].planning_ms += ms;
-        let sas = match report {
-            Ok(r) => match r.outcome {
-                Outcome::Plan(p) => btc_planner::to_sas_plan(domain, &self.pu.index, &p),
-                Outcome::Unsolvable => {
-                    attempt.outcome = format!(
-                        "no plan: no plan reaches `{goal_text}` from the state at {} s",
-                        self.secs(self.tick)
-                    );
-                    return self.attempt_failed(t, attempt, None);
-                }
-                Outcome::Timeout => {
-                    attempt.outcome = "no plan: the planner's time limit stopped it".into();
-                    return self.attempt_failed(t, attempt, None);
-                }
-            },
+        let plan = match planning {
+            Ok(Planning::Made { plan, .. }) => plan,
+            Ok(Planning::Unsolvable { .. }) => {
+                attempt.outcome = format!(
+                    "no plan: no plan reaches `{goal_text}` from the state at {} s",
+                    self.secs(self.tick)
+                );
+                return self.attempt_failed(t, attempt, None);
+            }
+            Ok(Planning::Timeout { .. }) => {
+                attempt.outcome = "no plan: the planner's time limit stopped it".into();
+                return self.attempt_failed(t, attempt, None);
+            }
             Err(d) => {
                 attempt.outcome = format!(
                     "no plan: {}",
@@ -127,18 +125,17 @@ impl<'w> Sim<'w, '_> {
                 return self.attempt_failed(t, attempt, None);
             }
         };
-        if sas.lines().all(|l| l.starts_with(';')) {
+        if plan.is_empty() {
             // The goal holds already (a plan of no steps).
             self.tm.tasks[t].state = TaskState::Done { tick: self.tick };
             return;
         }
         let path = self.agents[a].plan_path.clone();
-        self.db.set_file(&path, sas);
         let job = self.agents[a].job;
-        let doc = match db::compile(self.db, job) {
+        let doc = match execution::compile(self.db, job, &path, Some(&plan)) {
             Ok(ir) => {
                 attempt.plan = ir.steps.iter().map(|s| s.display()).collect();
-                TreeDoc::from_ir(ir)
+                TreeDoc::from_ir(&ir)
             }
             Err(e) => {
                 attempt.outcome = format!(
@@ -157,17 +154,13 @@ impl<'w> Sim<'w, '_> {
             ticks_per_action: time.ticks_per_action,
             ms_per_tick: (time.seconds_per_tick * 1000.0).round().max(1.0) as u64,
         };
-        let mut engine = match Engine::build(&doc, Some(kb), eopts) {
+        let mut engine = match execution::start(&doc, kb, eopts, self.tick - 1, self.opts.trace) {
             Ok(e) => e,
             Err(e) => {
                 attempt.outcome = format!("failed: the tree cannot run: {}", e.message);
                 return self.attempt_failed(t, attempt, None);
             }
         };
-        if self.opts.trace {
-            engine.observe(JsonlTrace::default());
-        }
-        engine.tick = self.tick - 1;
         // Challenges in effect reach the new tree too.
         let specs = self.faults_for(robot, self.tick);
         if !specs.is_empty() {
