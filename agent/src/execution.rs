@@ -10,6 +10,7 @@ use btc_lang::db::{self, CompileJob, Database, JobWorld};
 use btc_lang::path::AsFilePath;
 use btc_pddl::diagnostic::Diagnostic;
 use btc_pddl::logic::Formula;
+use btc_pddl::plan::WrittenPlan;
 use btc_pddl::source::Span;
 use btc_pddl::state::State;
 use btc_pddl::{Domain, DomainIndex, ProblemIndex};
@@ -37,25 +38,19 @@ impl<'a> From<&JobWorld<'a>> for PlanningWorld<'a> {
     }
 }
 
-/// A plan the planner made, in the form the compiler takes it: the plan
-/// file's text (the world it was made in is borrowed from the database
-/// the compiler then changes).
-pub struct MadePlan {
-    sas: String,
-    steps: usize,
-}
+/// A plan the planner made, as the value the compiler takes (the world it
+/// was made in is borrowed from the database the compiler then changes,
+/// so the plan carries its names).
+pub struct MadePlan(WrittenPlan);
 
 impl MadePlan {
     fn of(w: PlanningWorld<'_>, plan: &Plan) -> MadePlan {
-        MadePlan {
-            sas: btc_planner::to_sas_plan(w.domain, w.pix, plan),
-            steps: plan.steps.len(),
-        }
+        MadePlan(btc_planner::written_plan(w.domain, w.pix, plan))
     }
 
     /// The goal held already: the plan has no steps.
     pub fn is_empty(&self) -> bool {
-        self.steps == 0
+        self.0.is_empty()
     }
 }
 
@@ -103,16 +98,17 @@ pub fn plan(
 }
 
 /// Compiles the agent's job with `plan` as its plan (`None`: the plan the
-/// job's plan file holds already): the job's diagnostics when it does not
-/// compile.
+/// job has already, e.g. a plan file given): the job's diagnostics when it
+/// does not compile. The plan goes to the compiler as a value; its file
+/// holds only the text a diagnostic shows.
 pub fn compile(
     db: &mut Database,
     job: CompileJob,
     plan_file: &(impl AsFilePath + ?Sized),
-    plan: Option<&MadePlan>,
+    plan: Option<MadePlan>,
 ) -> Result<Arc<btc_ir::TreeIr>, Vec<Diagnostic>> {
-    if let Some(plan) = plan {
-        db.set_file(plan_file, plan.sas.clone());
+    if let Some(MadePlan(plan)) = plan {
+        db.set_plan(plan_file, plan);
     }
     db::compile(db, job).clone().map_err(|e| {
         if e.is_empty() {

@@ -83,6 +83,18 @@ impl Plan {
         }
     }
 
+    /// The plan as the compiler takes it, with its `sas_plan` text.
+    pub(crate) fn written(&self) -> btc_pddl::plan::WrittenPlan {
+        let mut w = btc_pddl::plan::PlanWriter::new();
+        for s in &self.steps {
+            w.step(&s.action, &s.args, s.time, s.duration);
+        }
+        if let Some(c) = self.cost {
+            w.cost(c, None);
+        }
+        w.finish()
+    }
+
     pub fn is_timed(&self) -> bool {
         self.steps.iter().any(|s| s.time.is_some())
     }

@@ -200,10 +200,9 @@ impl Project {
     /// it first, as `btc compile` does, and refused when it does not fit.
     pub fn compile(&mut self, plan: &Plan, problem: Option<&Path>) -> Result<Tree, Error> {
         let job = self.job(problem)?;
-        // The plan is the job's plan file: the database reads plans as
-        // files (a plan value of its own is still to come).
-        self.db
-            .set_file(&FilePath::new(PLAN_FILE), plan.to_string());
+        // The plan goes to the compiler as the value it is; its file holds
+        // the text diagnostics show.
+        self.db.set_plan(&FilePath::new(PLAN_FILE), plan.written());
         self.refuse_errors(job, |_| true)?;
         let replay: Vec<_> = project::fit::plan_validation(&self.db, job).to_vec();
         if has_errors(&replay) {

@@ -216,13 +216,39 @@ pub fn to_sas_plan(domain: &Domain, pix: &ProblemIndex, plan: &Plan) -> String {
 }
 
 /// `; cost = N (unit cost|general cost)`, a plan file's last line.
-fn cost_line(plan: &Plan) -> String {
+/// The plan as a value the compiler takes ([`btc_pddl::plan::WrittenPlan`]),
+/// whose text is what [`to_sas_plan`] writes.
+pub fn written_plan(
+    domain: &Domain,
+    pix: &ProblemIndex,
+    plan: &Plan,
+) -> btc_pddl::plan::WrittenPlan {
+    let mut w = btc_pddl::plan::PlanWriter::new();
+    for s in &plan.steps {
+        let args: Vec<&str> = s
+            .args
+            .iter()
+            .map(|&a| pix.object_names[a as usize].as_str())
+            .collect();
+        w.step(&domain.actions[s.action].name.name, &args, None, None);
+    }
+    let (total, kind) = cost_of(plan);
+    w.cost(total, Some(kind));
+    w.finish()
+}
+
+fn cost_of(plan: &Plan) -> (f64, &'static str) {
     let total = plan.base_cost + plan.cost as f64;
     let kind = if plan.unit_cost {
         "unit cost"
     } else {
         "general cost"
     };
+    (total, kind)
+}
+
+fn cost_line(plan: &Plan) -> String {
+    let (total, kind) = cost_of(plan);
     format!("; cost = {total} ({kind})\n")
 }
 

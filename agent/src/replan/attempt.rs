@@ -120,7 +120,7 @@ impl Run<'_, '_> {
         };
         let source = if made.is_some() { "planned" } else { "given" };
         let tc = Instant::now();
-        let ir = execution::compile(self.db, self.job, &self.plan_path, made.as_ref())
+        let ir = execution::compile(self.db, self.job, &self.plan_path, made)
             .map_err(LoopError::Compile)?;
         let compile_ms = tc.elapsed().as_secs_f64() * 1e3;
         let plan: Vec<String> = ir.steps.iter().map(|s| s.display()).collect();

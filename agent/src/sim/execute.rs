@@ -132,7 +132,7 @@ impl<'w> Sim<'w, '_> {
         }
         let path = self.agents[a].plan_path.clone();
         let job = self.agents[a].job;
-        let doc = match execution::compile(self.db, job, &path, Some(&plan)) {
+        let doc = match execution::compile(self.db, job, &path, Some(plan)) {
             Ok(ir) => {
                 attempt.plan = ir.steps.iter().map(|s| s.display()).collect();
                 TreeDoc::from_ir(&ir)

@@ -113,3 +113,46 @@ fn repeated_ground_actions_share_their_logic() {
     assert_eq!(children.len(), first.len() - skipped.len());
     assert!(first.len() < 20, "{} distinct ground actions", first.len());
 }
+
+/// A plan given as a value compiles to the tree its text compiles to,
+/// and what is wrong with it is reported in its text, as for a file.
+#[test]
+fn a_plan_value_compiles_as_its_text_does() {
+    let mut db = Database::new();
+    let job = example_job(&mut db, "examples/ariac");
+    let from_text = compile(&db, job).as_ref().expect("compiles").clone();
+    let steps = &typed_plan(&db, job).plan.steps;
+    let mut w = btc_pddl::plan::PlanWriter::new();
+    for s in steps {
+        w.step(&s.call.action, &s.call.args, s.time, s.duration);
+    }
+    let path = job.plan(&db).path(&db).clone();
+    let f = db.set_plan(&path, w.finish());
+    assert_eq!(f, job.plan(&db));
+    let from_value = compile(&db, job).as_ref().expect("compiles").clone();
+    // The same steps (the file has a header, so they sit on other lines).
+    let logic = |ir: &btc_ir::TreeIr| ir.steps.iter().map(|s| s.logic.clone()).collect::<Vec<_>>();
+    assert_eq!(logic(&from_text), logic(&from_value));
+    assert_eq!(from_text.root, from_value.root);
+    // An action the domain does not have, reported where its text has it.
+    let mut w = btc_pddl::plan::PlanWriter::new();
+    w.step(
+        "move",
+        &["floor_robot", "curr_position", "bin1"],
+        None,
+        None,
+    )
+    .step("fly", &["floor_robot"], None, None);
+    db.set_plan(&path, w.finish());
+    let errors = compile(&db, job).as_ref().expect_err("refused").clone();
+    let e = &errors[0];
+    let text = job.plan(&db).text(&db);
+    assert_eq!(
+        &text[e.span.start as usize..e.span.end as usize],
+        "fly",
+        "{e:?}"
+    );
+    // Text set again replaces the value.
+    db.set_file(&path, "(fly floor_robot)\n".to_owned());
+    assert!(job.plan(&db).written(&db).is_none());
+}

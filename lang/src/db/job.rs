@@ -72,7 +72,18 @@ pub struct TypedPlan {
 #[salsa::tracked(returns(ref))]
 pub fn typed_plan(db: &dyn Db, job: CompileJob) -> TypedPlan {
     let pf = job.plan(db);
-    let (plan, mut diagnostics) = btc_pddl::plan::parse_plan(pf.text(db), file_id(db, pf));
+    let file = file_id(db, pf);
+    let (plan, mut diagnostics) = match pf.written(db) {
+        Some(w) => {
+            let diags = if w.is_empty() {
+                vec![btc_pddl::plan::parse::no_steps(file)]
+            } else {
+                Vec::new()
+            };
+            (w.plan(file), diags)
+        }
+        None => btc_pddl::plan::parse_plan(pf.text(db), file),
+    };
     let mut steps = Vec::new();
     if let (Some(d), Some(p)) = (job_domain(db, job), job_problem(db, job)) {
         let cd = checked_domain(db, d);

@@ -51,6 +51,10 @@ pub struct SourceFile {
     pub text: String,
     #[returns(ref)]
     pub decode: Option<DecodeProblem>,
+    /// A plan given as a value ([`Database::set_plan`]): the compiler
+    /// takes it as it is, and `text` is only what it reads as.
+    #[returns(ref)]
+    pub written: Option<Arc<btc_pddl::plan::WrittenPlan>>,
 }
 
 /// Every file the database knows, by path, and the files a loader was
@@ -154,12 +158,28 @@ impl Database {
             if f.decode(self) != &decode {
                 f.set_decode(self).to(decode);
             }
+            if f.written(self).is_some() {
+                f.set_written(self).to(None);
+            }
             return f;
         }
-        let f = SourceFile::new(self, path.clone(), text, decode);
+        let f = SourceFile::new(self, path.clone(), text, decode, None);
         let mut files = ws.files(self).clone();
         files.insert(path, f);
         ws.set_files(self).to(files);
+        f
+    }
+
+    /// Adds or replaces a plan given as a value (a planner's): the file
+    /// at `path` holds the text it reads as, for diagnostics, and the
+    /// compiler takes the value without reading the text.
+    pub fn set_plan(
+        &mut self,
+        path: &(impl AsFilePath + ?Sized),
+        plan: btc_pddl::plan::WrittenPlan,
+    ) -> SourceFile {
+        let f = self.set_file(path, plan.text().to_owned());
+        f.set_written(self).to(Some(Arc::new(plan)));
         f
     }
 

@@ -95,14 +95,7 @@ fn read_plan(text: &str, file: FileId, quick: bool) -> (Plan, Vec<Diagnostic>) {
         }
     }
     if plan.steps.is_empty() && diags.is_empty() {
-        diags.push(
-            Diagnostic::warning(
-                codes::PLAN_EMPTY,
-                Span::new(file, 0, 0),
-                "this plan has no steps",
-            )
-            .with_hint("plan steps look like `(action arg ...)`; is this the right file?"),
-        );
+        diags.push(no_steps(file));
     }
     if plan.steps.iter().any(|s| s.time.is_some()) {
         // Temporal planners do not always print in time order (LPG).
@@ -112,6 +105,16 @@ fn read_plan(text: &str, file: FileId, quick: bool) -> (Plan, Vec<Diagnostic>) {
         });
     }
     (plan, diags)
+}
+
+/// The warning on a plan of no steps (read or given as a value).
+pub fn no_steps(file: FileId) -> Diagnostic {
+    Diagnostic::warning(
+        codes::PLAN_EMPTY,
+        Span::new(file, 0, 0),
+        "this plan has no steps",
+    )
+    .with_hint("plan steps look like `(action arg ...)`; is this the right file?")
 }
 
 /// Each line's start and text without its `\n`, as `split('\n')` cuts
