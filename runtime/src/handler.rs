@@ -44,5 +44,11 @@ impl ActionCall<'_> {
 }
 
 /// A leaf implementation: returns the leaf's status for this tick. Halting
-/// a RUNNING leaf resets it to IDLE without calling the handler.
+/// a RUNNING leaf resets it to IDLE without calling it; a [`HaltHandler`]
+/// hears of the halt.
 pub type ActionHandler<'w> = Box<dyn FnMut(&ActionCall<'_>) -> Status + 'w>;
+
+/// Told that a RUNNING leaf was halted (a reactive condition failed above
+/// it, a Parallel finished, the run stopped): the call names the leaf and
+/// its ports, as its last tick saw them.
+pub type HaltHandler<'w> = Box<dyn FnMut(&ActionCall<'_>) + 'w>;

@@ -26,7 +26,7 @@ pub use controller::{Command, Controller};
 pub use engine::{Engine, FaultRecord, Options, Status, Value};
 pub use error::LoadError;
 pub use faults::{FaultKind, FaultOutcome, Scenario};
-pub use handler::{ActionCall, ActionHandler};
+pub use handler::{ActionCall, ActionHandler, HaltHandler};
 pub use kb::Kb;
 pub use spec::TreeDoc;
 

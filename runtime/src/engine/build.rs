@@ -71,6 +71,7 @@ impl<'w> Engine<'w> {
             faults_live: false,
             controller: None,
             handlers: Vec::new(),
+            halt_handlers: Vec::new(),
             record_slots: [0; 4],
             step_running: None,
         };
@@ -922,6 +923,7 @@ impl<'d, 'e, 'w> Builder<'d, 'e, 'w> {
                     id: id.into(),
                     ports: range,
                     handler: None,
+                    on_halt: None,
                 });
                 Op::Action(a)
             }

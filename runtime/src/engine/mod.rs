@@ -38,7 +38,7 @@ pub use value::Value;
 
 use crate::controller::Controller;
 use crate::faults::FaultRt;
-use crate::handler::ActionHandler;
+use crate::handler::{ActionHandler, HaltHandler};
 use crate::kb::{ConditionId, EffectId, FormulaId, Kb};
 use serde::Serialize;
 use state::NodeState;
@@ -141,6 +141,8 @@ pub(crate) struct ActionInfo {
     pub ports: (u32, u32),
     /// The embedder's implementation ([`Engine::set_action_handler`]).
     pub handler: Option<u32>,
+    /// What hears of its halts ([`Engine::set_halt_handler`]).
+    pub on_halt: Option<u32>,
 }
 
 pub(crate) struct CondInfo {
@@ -202,6 +204,7 @@ pub struct Engine<'w> {
     pub(crate) faults_live: bool,
     pub(crate) controller: Option<Controller>,
     pub(crate) handlers: Vec<ActionHandler<'w>>,
+    pub(crate) halt_handlers: Vec<HaltHandler<'w>>,
     pub(crate) record_slots: [u32; 4],
     /// The step that started last, while it has not finished.
     pub(crate) step_running: Option<u32>,
@@ -416,6 +419,11 @@ impl<'w> Engine<'w> {
         };
         if !keep {
             self.state[iu] = NodeState::Fresh;
+        }
+        if let Op::Action(a) = def.op {
+            if let Some(h) = self.actions[a as usize].on_halt {
+                self.halt_handled(i, a, h);
+            }
         }
         if def.guard != NO_GUARD {
             self.on_halted(i, def.guard);
