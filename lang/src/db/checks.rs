@@ -312,8 +312,23 @@ pub fn file_coverage(db: &dyn Db, file: SourceFile) -> Vec<Finding> {
 #[salsa::tracked(returns(ref))]
 pub fn file_unused(db: &dyn Db, file: SourceFile) -> Vec<Finding> {
     let items = rules_items(db, file);
-    let uses: Vec<&ItemUses> = items.iter().map(|i| item_uses(db, *i)).collect();
+    let mut uses: Vec<&ItemUses> = items.iter().map(|i| item_uses(db, *i)).collect();
+    uses.push(imported_uses(db, file));
     file_checks::unused(item_heads(db, file), &uses)
+}
+
+/// The names the imported BT.CPP trees use: a node declared in the rules
+/// for an imported tree is used.
+#[salsa::tracked(returns(ref))]
+pub fn imported_uses(db: &dyn Db, file: SourceFile) -> ItemUses {
+    let decls = declarations(db, file);
+    let mut out = ItemUses::default();
+    for t in decls.imported.iter().filter_map(|n| decls.trees.get(n)) {
+        let u = file_checks::uses(&Item::Tree(t.clone()));
+        out.names.extend(u.names);
+        out.broken |= u.broken;
+    }
+    out
 }
 
 /// Every diagnostic of a rules file itself (not of its PDDL files), with

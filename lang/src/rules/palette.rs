@@ -104,7 +104,7 @@ pub fn parse_palette(text: &str, file: FileId) -> (Vec<ItemNode>, Vec<Diagnostic
                 diags.push(not_a_palette(
                     file,
                     r.error_position() as usize,
-                    format!("this palette is not well-formed XML: {e}"),
+                    format!("this XML file is not well-formed: {e}"),
                 ));
                 return (items, diags);
             }
@@ -234,7 +234,7 @@ pub fn parse_palette(text: &str, file: FileId) -> (Vec<ItemNode>, Vec<Diagnostic
                     diags.push(not_a_palette(
                         file,
                         text.len(),
-                        "this palette ends inside an element that is never closed".to_owned(),
+                        "this XML file ends inside an element that is never closed".to_owned(),
                     ));
                     return (items, diags);
                 }

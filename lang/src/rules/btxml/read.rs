@@ -44,7 +44,8 @@ pub fn read_trees(text: &str, file: FileId) -> XmlTrees {
     loop {
         let before = r.buffer_position() as usize;
         let Ok(ev) = r.read_event() else {
-            break;
+            // What the file names cannot be judged from part of it.
+            return out;
         };
         let (e, empty) = match &ev {
             Event::Start(e) => (e.clone(), false),
@@ -57,7 +58,9 @@ pub fn read_trees(text: &str, file: FileId) -> XmlTrees {
                 }
                 continue;
             }
-            Event::Eof => break,
+            Event::Eof if stack.is_empty() && skip == 0 => break,
+            // Unclosed: the palette reader reports it (R070).
+            Event::Eof => return out,
             _ => continue,
         };
         let at = text[before..].find('<').map_or(before, |k| before + k);
@@ -190,8 +193,11 @@ fn close(open: Open, stack: &mut [Open], out: &mut XmlTrees) {
             }
         }
         _ => {
-            let t = element(open, &mut out.diagnostics);
-            if let (Some(t), Some(parent)) = (t, stack.last_mut()) {
+            let span = open.tag_span;
+            // An element btc cannot carry stays in its parent as an error
+            // (reported), so the parent's children are still counted right.
+            let t = element(open, &mut out.diagnostics).unwrap_or(Template::Error { span });
+            if let Some(parent) = stack.last_mut() {
                 parent.children.push(t);
             }
         }

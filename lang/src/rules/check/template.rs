@@ -141,6 +141,10 @@ impl Tcx<'_> {
 
     pub(super) fn call(&mut self, name: &Ident, args: &[Arg], span: Span) {
         let Some(ports) = self.decls.ports(&name.text) else {
+            if self.imported && name.text.starts_with(crate::rules::btxml::SUBTREE_PREFIX) {
+                // A <SubTree> naming no tree of its file: R073 already.
+                return;
+            }
             if self.imported {
                 self.err(unknown_name(
                     Diagnostic::error(
