@@ -94,7 +94,7 @@ fn every_emit_fixture_with_every_emitter() {
 /// imported tree is in the output as the rules' own trees are.
 #[test]
 fn imported_btcpp_trees_with_every_emitter() {
-    let rules = Path::new("runtime/tests/fixtures/three_way/timed/imported.btrules");
+    let rules = Path::new("runtime/tests/fixtures/three_way/timed/scheduled_imported.btrules");
     for emit in EMITTERS {
         let extra: &[&str] = if *emit == "pytrees" {
             &["--runtime", "import"]

@@ -567,7 +567,7 @@ fn step_events_and_commands(
 fn imported_btcpp_trees_run_as_their_hand_written_equivalent() {
     let dir = "runtime/tests/fixtures/three_way/timed";
     let plan = format!("{dir}/plan.tplan");
-    let imported = format!("{dir}/imported.btrules");
+    let imported = format!("{dir}/scheduled_imported.btrules");
     let (events, commands) = step_events_and_commands(&imported, &plan);
     let (hand_events, hand_commands) =
         step_events_and_commands(&format!("{dir}/scheduled.btrules"), &plan);
