@@ -58,3 +58,152 @@ impl XmlTrees {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rules::ast::{Item, NodeDecl, NodeKind, PortDecl, Value};
+    use crate::rules::decls::Decls;
+
+    fn node(name: &str, ports: &[(&str, &str, bool)]) -> NodeDecl {
+        let id = |t: &str| Ident::new(t.to_owned(), Span::new(0, 0, 0));
+        NodeDecl {
+            kind: NodeKind::Action,
+            name: id(name),
+            ports: ports
+                .iter()
+                .map(|(n, t, out)| PortDecl {
+                    out: *out,
+                    name: id(n),
+                    ty: id(t),
+                    span: Span::new(0, 0, 0),
+                })
+                .collect(),
+            formula: None,
+            span: Span::new(0, 0, 0),
+        }
+    }
+
+    const TRANSPORT: &str = r#"<root BTCPP_format="4" main_tree_to_execute="MainTree">
+  <BehaviorTree ID="MainTree">
+    <Sequence name="transport">
+      <SubTree ID="Carry" _autoremap="true"/>
+      <Report done="{arrived}"/>
+    </Sequence>
+  </BehaviorTree>
+  <BehaviorTree ID="Carry">
+    <Retry num_attempts="2"><Transport robot="{arg0}" speed="0.5" to="{arg3}"/></Retry>
+  </BehaviorTree>
+</root>"#;
+
+    #[test]
+    fn trees_become_declarations_with_their_entries_as_typed_ports() {
+        let x = read_trees(TRANSPORT, 3);
+        // `Retry` is the rules keyword, not BT.CPP's tag: refused.
+        assert_eq!(x.diagnostics.len(), 1, "{:?}", x.diagnostics);
+        assert_eq!(x.diagnostics[0].code, "R072");
+        let x = read_trees(
+            &TRANSPORT
+                .replace("Retry ", "RetryUntilSuccessful ")
+                .replace("</Retry>", "</RetryUntilSuccessful>"),
+            3,
+        );
+        assert!(x.diagnostics.is_empty(), "{:?}", x.diagnostics);
+        assert_eq!(x.main.as_deref(), Some("MainTree"));
+        let mut decls = Decls::default();
+        decls.nodes.insert(
+            "Transport".into(),
+            node(
+                "Transport",
+                &[
+                    ("robot", "robot", false),
+                    ("speed", "float", false),
+                    ("to", "zone", false),
+                ],
+            ),
+        );
+        decls
+            .nodes
+            .insert("Report".into(), node("Report", &[("done", "bool", true)]));
+        let alias = Ident::new("TransportTree".into(), Span::new(0, 0, 0));
+        let names = typing::tree_names(&x, Some(&alias)).unwrap();
+        assert_eq!(names, ["TransportTree", "TransportTree::Carry"]);
+        let trees = imported_trees(&x, &names, &decls);
+        let main = trees
+            .iter()
+            .find(|t| t.name.text == "TransportTree")
+            .unwrap();
+        let ports: Vec<(&str, &str, bool)> = main
+            .ports
+            .iter()
+            .map(|p| (p.name.text.as_str(), p.ty.text.as_str(), p.out))
+            .collect();
+        // Through `_autoremap`, the called tree's ports; `arrived` only
+        // written by an output port.
+        assert_eq!(
+            ports,
+            [
+                ("arg0", "robot", false),
+                ("arg3", "zone", false),
+                ("arrived", "bool", true)
+            ]
+        );
+        // The SubTree call is named and its ports remapped by name.
+        let mut seen = Vec::new();
+        Template::walk_all(&main.body, &mut |t| {
+            if let Template::Call { name, args, .. } = t {
+                seen.push((
+                    name.text.clone(),
+                    args.iter().map(|a| a.port.text.clone()).collect::<Vec<_>>(),
+                ));
+            }
+        });
+        assert_eq!(
+            seen[0],
+            (
+                "TransportTree::Carry".to_owned(),
+                vec!["arg0".to_owned(), "arg3".to_owned()]
+            )
+        );
+        // A literal is read as its port's type: `speed="0.5"` is a float.
+        let carry = trees
+            .iter()
+            .find(|t| t.name.text == "TransportTree::Carry")
+            .unwrap();
+        let mut speed = None;
+        Template::walk_all(&carry.body, &mut |t| {
+            if let Template::Call { args, .. } = t {
+                speed = args
+                    .iter()
+                    .find(|a| a.port.text == "speed")
+                    .map(|a| a.value.clone());
+            }
+        });
+        assert!(matches!(speed, Some(Value::Float { value, .. }) if value == 0.5));
+        // The tag's span is in the XML.
+        let Template::Control { span, .. } = &main.body[0] else {
+            panic!("{:?}", main.body)
+        };
+        assert_eq!(
+            &TRANSPORT[span.start as usize..span.end as usize],
+            "Sequence"
+        );
+        let _ = Item::Tree(main.clone());
+    }
+
+    #[test]
+    fn unknown_subtrees_cycles_and_unpicked_main_trees_are_reported() {
+        let x = read_trees(
+            r#"<root BTCPP_format="4"><BehaviorTree ID="A"><SubTree ID="B"/></BehaviorTree>
+<BehaviorTree ID="B"><SubTree ID="A"/></BehaviorTree>
+<BehaviorTree ID="C"><SubTree ID="Bee"/></BehaviorTree></root>"#,
+            0,
+        );
+        let codes: Vec<&str> = x.diagnostics.iter().map(|d| d.code).collect();
+        assert_eq!(codes, ["R073", "R073", "R073"], "{:?}", x.diagnostics);
+        assert!(x.diagnostics[0].hint.as_deref().unwrap().contains("`B`"));
+        let alias = Ident::new("T".into(), Span::new(0, 0, 0));
+        assert!(typing::tree_names(&x, Some(&alias)).is_err());
+        assert_eq!(typing::tree_names(&x, None).unwrap(), ["A", "B", "C"]);
+    }
+}
