@@ -122,7 +122,7 @@ fn rule_sets() -> Vec<RuleSet> {
         "timed",
         &timed,
         "plan.tplan",
-        &["scheduled", "in_order"],
+        &["scheduled", "in_order", "scheduled_imported"],
     );
     for d in btc_testkit::corpus_rules().unwrap_or_default() {
         sets.push(RuleSet {

@@ -89,6 +89,29 @@ fn every_emit_fixture_with_every_emitter() {
     }
 }
 
+/// PlanSys2-style per-action BT.CPP trees imported into the rules
+/// (`import "trees/move.xml" as MoveTree`) through every emitter: each
+/// imported tree is in the output as the rules' own trees are.
+#[test]
+fn imported_btcpp_trees_with_every_emitter() {
+    let rules = Path::new("runtime/tests/fixtures/three_way/timed/scheduled_imported.btrules");
+    for emit in EMITTERS {
+        let extra: &[&str] = if *emit == "pytrees" {
+            &["--runtime", "import"]
+        } else {
+            &[]
+        };
+        insta::assert_snapshot!(
+            format!("imported_trees_{emit}"),
+            compile(rules, emit, extra)
+        );
+    }
+    insta::assert_snapshot!(
+        "imported_trees_btcpp_inline",
+        compile(rules, "btcpp", &["--inline"])
+    );
+}
+
 /// `name="..."` attribute values of an XML text.
 fn name_attributes(xml: &str) -> Vec<&str> {
     xml.split(" name=\"")

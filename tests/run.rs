@@ -525,3 +525,59 @@ fn a_timed_plans_durations_become_ticks_on_request() {
     let out = btc(&["run", &rules, "--replan", "--ticks-per-time-unit", "5"]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+/// The `(tick, event, step)` of each step start and end in a `btc run`'s
+/// trace, and the leaves' commands.
+fn step_events_and_commands(
+    rules: &str,
+    plan: &str,
+) -> (Vec<(u64, String, u64)>, Vec<serde_json::Value>) {
+    let dir = tempfile::tempdir().unwrap();
+    let trace = dir.path().join("trace.jsonl");
+    let out = btc(&[
+        "run",
+        rules,
+        "--plan",
+        plan,
+        "--trace",
+        trace.to_str().unwrap(),
+    ]);
+    exits(&out, 0, rules);
+    let events = std::fs::read_to_string(&trace)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str::<serde_json::Value>(l).unwrap())
+        .filter(|l| l["event"] == "step_started" || l["event"] == "step_finished")
+        .map(|l| {
+            (
+                l["tick"].as_u64().unwrap(),
+                l["event"].as_str().unwrap().to_owned(),
+                l["step"].as_u64().unwrap(),
+            )
+        })
+        .collect();
+    (events, commands_of(&["run", rules, "--plan", plan], rules))
+}
+
+/// PlanSys2-style per-action BT.CPP trees imported into the rules run as
+/// the hand-written rules that mean the same: the same step starts and
+/// ends at the same ticks, the same leaves with the same ports, from the
+/// rules, the IR and the XML.
+#[test]
+fn imported_btcpp_trees_run_as_their_hand_written_equivalent() {
+    let dir = "runtime/tests/fixtures/three_way/timed";
+    let plan = format!("{dir}/plan.tplan");
+    let imported = format!("{dir}/scheduled_imported.btrules");
+    let (events, commands) = step_events_and_commands(&imported, &plan);
+    let (hand_events, hand_commands) =
+        step_events_and_commands(&format!("{dir}/scheduled.btrules"), &plan);
+    assert_eq!(events.len(), 44, "{events:?}");
+    assert_eq!(events, hand_events);
+    assert_eq!(commands, hand_commands);
+    same_commands_from_the_ir_and_the_xml(
+        &imported,
+        &plan,
+        &format!("{dir}/problem.pddl"),
+        &commands,
+    );
+}

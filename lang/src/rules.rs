@@ -2,6 +2,7 @@
 
 pub mod actions;
 pub mod ast;
+pub mod btxml;
 pub mod check;
 pub mod decls;
 pub mod file_checks;

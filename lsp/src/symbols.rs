@@ -36,7 +36,7 @@ pub fn item_symbols(a: &Analysis) -> Vec<ItemSymbol> {
             ),
             Item::Import { target, span } => (
                 match target {
-                    ImportTarget::Path { path } => {
+                    ImportTarget::Path { path, .. } => {
                         format!("import {}", path.plain().unwrap_or_default())
                     }
                     ImportTarget::Std { module } => format!("import std::{}", module.text),

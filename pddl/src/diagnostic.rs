@@ -339,8 +339,13 @@ pub mod codes {
         R_SKIP_CHANGES = "R044", "a `=> skip` rule for steps whose effects change the world";
         R_TOO_DEEP = "R060", "a template nested deeper than btc supports";
         // Node palettes imported from BT.CPP XML (`import "nodes.xml"`)
-        R_PALETTE = "R070", "an imported node palette that is not BT.CPP XML with a <TreeNodesModel>";
+        R_PALETTE = "R070", "an imported BT.CPP XML file that is not well-formed, or has neither a <TreeNodesModel> nor a <BehaviorTree>";
         R_PALETTE_TYPE = "R071", "a palette port whose C++ type btc cannot check";
+        // BT.CPP trees imported from XML (`import "move.xml" as Move`)
+        R_XML_CONSTRUCT = "R072", "a construct in an imported BT.CPP tree that btc cannot carry into every output";
+        R_XML_SUBTREE = "R073", "a <SubTree> of an imported BT.CPP file that names no tree of the file, or calls itself";
+        R_XML_TREE_NAME = "R074", "an imported BT.CPP file whose tree an `as` name or `main_tree_to_execute` cannot pick";
+        R_XML_NODE = "R075", "a node of an imported BT.CPP tree that neither a palette nor the rules declare";
         // .btrules: BT.CPP scripts on nodes (`[skip_if: "..."]`, `script "..."`)
         R_SCRIPT_KEY = "R120", "a script attribute on a node that is not one of BT.CPP's pre- or post-conditions";
         R_SCRIPT_TWICE = "R121", "a node that gives the same pre- or post-condition twice";

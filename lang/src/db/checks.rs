@@ -23,7 +23,7 @@ pub fn import_closure(db: &dyn Db, file: SourceFile) -> (Vec<SourceFile>, Vec<Di
                     .files(db)
                     .get(&FilePath::std(&module.text))
                     .copied(),
-                ImportTarget::Path { path } => path.plain().and_then(|p| resolve(db, f, &p)),
+                ImportTarget::Path { path, .. } => path.plain().and_then(|p| resolve(db, f, &p)),
             };
             match found {
                 Some(g) if !order.contains(&g) => order.push(g),
@@ -41,7 +41,7 @@ pub fn import_closure(db: &dyn Db, file: SourceFile) -> (Vec<SourceFile>, Vec<Di
                                     .join(", ")
                             ),
                         ),
-                        ImportTarget::Path { path } => (
+                        ImportTarget::Path { path, .. } => (
                             format!("cannot find `{}`", path.plain().unwrap_or_default()),
                             "import paths are relative to the importing file".to_owned(),
                         ),
@@ -56,14 +56,131 @@ pub fn import_closure(db: &dyn Db, file: SourceFile) -> (Vec<SourceFile>, Vec<Di
     (order, diags)
 }
 
-/// Declarations visible in a rules file: its own first, then its imports'.
+/// Declarations visible in a rules file: its own first, then its imports',
+/// then the trees of the BT.CPP files it and its imports import (typed
+/// from the nodes declared before them).
 #[salsa::tracked(returns(ref))]
 pub fn declarations(db: &dyn Db, file: SourceFile) -> Decls {
     let mut decls = Decls::default();
     for f in &import_closure(db, file).0 {
         decls.add_items(&parsed_rules(db, *f).items);
     }
+    for imp in xml_imports(db, file) {
+        let x = xml_trees(db, imp.xml);
+        if let Ok(names) = tree_names(x, imp.alias.as_ref()) {
+            let trees = imported_trees(x, &names, &decls);
+            decls.add_imported(trees);
+        }
+    }
     decls
+}
+
+/// An `import "FILE.xml" [as NAME]` of a rules file in the import closure.
+#[derive(Clone, Debug, PartialEq)]
+pub struct XmlImport {
+    pub xml: SourceFile,
+    pub alias: Option<Ident>,
+    /// The importing file and the import item's offset in it (the alias's
+    /// span is relative to it).
+    pub from: SourceFile,
+    pub offset: u32,
+}
+
+/// The BT.CPP files imported by a rules file and its imports, in order.
+#[salsa::tracked(returns(ref))]
+pub fn xml_imports(db: &dyn Db, file: SourceFile) -> Vec<XmlImport> {
+    let mut out = Vec::new();
+    for &f in &import_closure(db, file).0 {
+        for n in &parsed_rules(db, f).items {
+            let Item::Import {
+                target: ImportTarget::Path { path, alias },
+                ..
+            } = &*n.item
+            else {
+                continue;
+            };
+            if let Some(xml) = path.plain().and_then(|p| resolve(db, f, &p)) {
+                if is_palette(xml.path(db)) {
+                    out.push(XmlImport {
+                        xml,
+                        alias: alias.clone(),
+                        from: f,
+                        offset: n.offset,
+                    });
+                }
+            }
+        }
+    }
+    out
+}
+
+/// A BT.CPP file's trees, read once.
+#[salsa::tracked(returns(ref))]
+pub fn xml_trees(db: &dyn Db, file: SourceFile) -> XmlTrees {
+    crate::rules::btxml::read_trees(file.text(db), file_id(db, file))
+}
+
+/// What is wrong with the BT.CPP trees a rules file imports: the files'
+/// own problems, an `as` name that picks no tree (R074, at the name), an
+/// `as` on a rules file, and each imported tree checked against the
+/// importing file's declarations.
+fn imported_tree_diagnostics(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
+    let mut out = Vec::new();
+    let id = file_id(db, file);
+    let mut seen = Vec::new();
+    for imp in xml_imports(db, file) {
+        let x = xml_trees(db, imp.xml);
+        if !seen.contains(&imp.xml) {
+            seen.push(imp.xml);
+            out.extend(x.diagnostics.iter().cloned());
+        }
+        if let (Err(why), Some(alias), true) = (
+            tree_names(x, imp.alias.as_ref()),
+            &imp.alias,
+            imp.from == file,
+        ) {
+            let d = Diagnostic::error(codes::R_XML_TREE_NAME, alias.span, why).with_hint(
+                "set `main_tree_to_execute` on the file's <root>, or import it without `as` and call its trees by their IDs",
+            );
+            out.push(shift(d, id, imp.offset));
+        }
+    }
+    for n in own_items(db, file) {
+        if let Item::Import {
+            target:
+                ImportTarget::Path {
+                    path,
+                    alias: Some(alias),
+                },
+            ..
+        } = &*n.item
+        {
+            let xml = path
+                .plain()
+                .and_then(|p| resolve(db, file, &p))
+                .is_none_or(|f| is_palette(f.path(db)));
+            if !xml {
+                let d = Diagnostic::error(
+                    codes::R_XML_TREE_NAME,
+                    alias.span,
+                    format!(
+                        "`as {}` names a BT.CPP file's main tree; this import is a rules file",
+                        alias.text
+                    ),
+                )
+                .with_hint("a rules file's declarations keep their own names: remove `as ...`");
+                out.push(shift(d, id, n.offset));
+            }
+        }
+    }
+    let decls = declarations(db, file);
+    let ctx = domain_ctx(db, file);
+    for name in &decls.imported {
+        if let Some(t) = decls.trees.get(name) {
+            out.extend(check_imported_tree(t, decls, ctx));
+        }
+    }
+    out
 }
 
 /// The domain's action names indexed for matching patterns.
@@ -195,8 +312,23 @@ pub fn file_coverage(db: &dyn Db, file: SourceFile) -> Vec<Finding> {
 #[salsa::tracked(returns(ref))]
 pub fn file_unused(db: &dyn Db, file: SourceFile) -> Vec<Finding> {
     let items = rules_items(db, file);
-    let uses: Vec<&ItemUses> = items.iter().map(|i| item_uses(db, *i)).collect();
+    let mut uses: Vec<&ItemUses> = items.iter().map(|i| item_uses(db, *i)).collect();
+    uses.push(imported_uses(db, file));
     file_checks::unused(item_heads(db, file), &uses)
+}
+
+/// The names the imported BT.CPP trees use: a node declared in the rules
+/// for an imported tree is used.
+#[salsa::tracked(returns(ref))]
+pub fn imported_uses(db: &dyn Db, file: SourceFile) -> ItemUses {
+    let decls = declarations(db, file);
+    let mut out = ItemUses::default();
+    for t in decls.imported.iter().filter_map(|n| decls.trees.get(n)) {
+        let u = file_checks::uses(&Item::Tree(t.clone()));
+        out.names.extend(u.names);
+        out.broken |= u.broken;
+    }
+    out
 }
 
 /// Every diagnostic of a rules file itself (not of its PDDL files), with
@@ -213,6 +345,7 @@ pub fn rules_diagnostics(db: &dyn Db, file: SourceFile) -> Vec<Diagnostic> {
             out.extend(parsed_rules(db, f).diagnostics.iter().cloned());
         }
     }
+    out.extend(imported_tree_diagnostics(db, file));
     for item in rules_items(db, file) {
         let offset = item.offset(db);
         out.extend(

@@ -176,7 +176,10 @@ fn item_key(item: &Item) -> String {
         Item::Domain { .. } => "domain".into(),
         Item::Problem { .. } => "problem".into(),
         Item::Import { target, .. } => match target {
-            ImportTarget::Path { path } => format!("import {:?}", path.plain()),
+            ImportTarget::Path { path, alias } => match alias {
+                Some(a) => format!("import {:?} as {}", path.plain(), a.text),
+                None => format!("import {:?}", path.plain()),
+            },
             ImportTarget::Std { module } => format!("import std::{}", module.text),
         },
         Item::Node(n) => format!("node {}", n.name.text),

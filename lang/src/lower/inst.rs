@@ -115,10 +115,12 @@ fn expand_tree(decl: &TreeDecl, args: &[Arg]) -> Vec<Template> {
                 name,
                 args,
                 scripts,
+                label,
                 span,
             } => Template::Call {
                 name: name.clone(),
                 scripts: scripts.clone(),
+                label: label.as_ref().map(|l| string(l, arg)),
                 args: args
                     .iter()
                     .map(|a| Arg {
@@ -396,6 +398,7 @@ impl<'a> Inst<'a> {
                 name,
                 args,
                 scripts: attrs,
+                label,
                 ..
             } => {
                 let scripts = node_scripts(attrs);
@@ -435,11 +438,12 @@ impl<'a> Inst<'a> {
                     Some(NodeKind::Condition) => LeafKind::Condition,
                     _ => LeafKind::Action,
                 };
+                let label = self.name(label);
                 vec![Node::Leaf {
                     scripts,
                     leaf,
                     id: name.text.clone(),
-                    name: None,
+                    name: label,
                     ports,
                 }]
             }

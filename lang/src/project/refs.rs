@@ -47,7 +47,7 @@ pub fn references(db: &dyn Db, file: SourceFile) -> Vec<Reference> {
             Item::Domain { path, .. } => (RefKind::Domain, path),
             Item::Problem { path, .. } => (RefKind::Problem, path),
             Item::Import {
-                target: ImportTarget::Path { path },
+                target: ImportTarget::Path { path, .. },
                 ..
             } => (RefKind::Import, path),
             _ => continue,

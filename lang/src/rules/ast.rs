@@ -91,8 +91,15 @@ impl StrLit {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "lowercase")]
 pub enum ImportTarget {
-    Path { path: StrLit },
-    Std { module: Ident },
+    /// `import "move.xml" as Move`: `alias` names a BT.CPP file's main tree.
+    Path {
+        path: StrLit,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        alias: Option<Ident>,
+    },
+    Std {
+        module: Ident,
+    },
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -425,6 +432,10 @@ pub enum Template {
         /// `[skip_if: "...", on_success: "..."]` after the arguments.
         #[serde(default, skip_serializing_if = "Vec::is_empty")]
         scripts: Vec<ScriptAttr>,
+        /// The node's `name`: only a leaf of an imported BT.CPP tree has
+        /// one (`<Move name="move" .../>`); the rules have no syntax for it.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        label: Option<StrLit>,
         span: Span,
     },
     /// `script "code"` (BT.CPP's `Script`) or `script_condition "code"`

@@ -15,6 +15,9 @@ pub struct Decls {
     pub nodes: BTreeMap<String, NodeDecl>,
     pub trees: BTreeMap<String, TreeDecl>,
     pub tables: BTreeMap<String, TableDecl>,
+    /// The names of the trees read from imported BT.CPP XML files, in
+    /// `trees` with them; their bodies are checked with the importing file.
+    pub imported: Vec<String>,
 }
 
 impl Decls {
@@ -37,6 +40,17 @@ impl Decls {
                         .or_insert_with(|| t.clone());
                 }
                 _ => {}
+            }
+        }
+    }
+
+    /// Trees of an imported BT.CPP file, after the rules' own declarations
+    /// (which win a name both have).
+    pub fn add_imported(&mut self, trees: Vec<TreeDecl>) {
+        for t in trees {
+            if !self.trees.contains_key(&t.name.text) {
+                self.imported.push(t.name.text.clone());
+                self.trees.insert(t.name.text.clone(), t);
             }
         }
     }

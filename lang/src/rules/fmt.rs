@@ -128,7 +128,13 @@ impl Formatter<'_> {
             Item::Domain { path, .. } => self.push(0, format!("domain {}", string(path))),
             Item::Problem { path, .. } => self.push(0, format!("problem {}", string(path))),
             Item::Import { target, .. } => match target {
-                ImportTarget::Path { path } => self.push(0, format!("import {}", string(path))),
+                ImportTarget::Path { path, alias } => self.push(
+                    0,
+                    match alias {
+                        Some(a) => format!("import {} as {}", string(path), a.text),
+                        None => format!("import {}", string(path)),
+                    },
+                ),
                 ImportTarget::Std { module } => {
                     self.push(0, format!("import std::{}", module.text))
                 }

@@ -36,14 +36,20 @@ pub fn rules_type(cpp: &str) -> Option<&'static str> {
 }
 
 /// An attribute's value and the span of the value in the text.
-struct Attr {
-    key: String,
-    value: String,
-    span: Span,
+pub(super) struct Attr {
+    pub(super) key: String,
+    pub(super) value: String,
+    pub(super) span: Span,
 }
 
 /// The attributes of an element whose text starts at `at`.
-fn attrs(e: &BytesStart, r: &Reader<&[u8]>, text: &str, at: usize, file: FileId) -> Vec<Attr> {
+pub(super) fn attrs(
+    e: &BytesStart,
+    r: &Reader<&[u8]>,
+    text: &str,
+    at: usize,
+    file: FileId,
+) -> Vec<Attr> {
     let raw = &text[at..];
     let end = raw.find('>').map_or(raw.len(), |k| k + 1);
     let raw = &raw[..end];
@@ -67,18 +73,20 @@ fn attrs(e: &BytesStart, r: &Reader<&[u8]>, text: &str, at: usize, file: FileId)
     out
 }
 
-fn get<'a>(attrs: &'a [Attr], key: &str) -> Option<&'a Attr> {
+pub(super) fn get<'a>(attrs: &'a [Attr], key: &str) -> Option<&'a Attr> {
     attrs.iter().find(|a| a.key == key)
 }
 
 fn not_a_palette(file: FileId, at: usize, why: String) -> Diagnostic {
     Diagnostic::error(codes::R_PALETTE, Span::new(file, at, at), why).with_hint(
-        "a palette is BT.CPP XML with a <TreeNodesModel> (`BT::writeTreeNodesModelXML`, or Groot2's)",
+        "an imported .xml file is BT.CPP XML: a <TreeNodesModel> palette (`BT::writeTreeNodesModelXML`, or Groot2's), <BehaviorTree> elements, or both",
     )
 }
 
 /// The node declarations of a palette, each an item with absolute spans
-/// (offset 0), and what is wrong with it.
+/// (offset 0), and what is wrong with it. A file of trees without a
+/// `<TreeNodesModel>` declares no nodes and is not wrong for it: its trees
+/// are read by `btxml`.
 pub fn parse_palette(text: &str, file: FileId) -> (Vec<ItemNode>, Vec<Diagnostic>) {
     let mut items = Vec::new();
     let mut diags = Vec::new();
@@ -96,7 +104,7 @@ pub fn parse_palette(text: &str, file: FileId) -> (Vec<ItemNode>, Vec<Diagnostic
                 diags.push(not_a_palette(
                     file,
                     r.error_position() as usize,
-                    format!("this palette is not well-formed XML: {e}"),
+                    format!("this XML file is not well-formed: {e}"),
                 ));
                 return (items, diags);
             }
@@ -226,7 +234,7 @@ pub fn parse_palette(text: &str, file: FileId) -> (Vec<ItemNode>, Vec<Diagnostic
                     diags.push(not_a_palette(
                         file,
                         text.len(),
-                        "this palette ends inside an element that is never closed".to_owned(),
+                        "this XML file ends inside an element that is never closed".to_owned(),
                     ));
                     return (items, diags);
                 }
@@ -235,11 +243,11 @@ pub fn parse_palette(text: &str, file: FileId) -> (Vec<ItemNode>, Vec<Diagnostic
             _ => {}
         }
     }
-    if !saw_models {
+    if !saw_models && !super::btxml::has_trees(text) {
         diags.push(not_a_palette(
             file,
             0,
-            "this XML has no <TreeNodesModel>: it declares no nodes".to_owned(),
+            "this XML has neither a <TreeNodesModel> nor a <BehaviorTree>: it declares no nodes and no trees".to_owned(),
         ));
     }
     (items, diags)

@@ -129,7 +129,7 @@ pub fn resolve_item(item: &Item, decls: &Decls, ctx: Option<DomainCtx>) -> Vec<N
     match item {
         Item::Domain { path, .. } | Item::Problem { path, .. } => w.path(path),
         Item::Import { target, .. } => match target {
-            ImportTarget::Path { path } => w.path(path),
+            ImportTarget::Path { path, .. } => w.path(path),
             ImportTarget::Std { module } => w.push(
                 module.span,
                 Target::Std {

@@ -90,11 +90,21 @@ pub fn load(rules: &Path, plan: &Path, problem: &Path) -> Example {
         .map(|d| dir.join(d.trim_end_matches('"')))
         .into_iter()
         .collect();
-    let mut names: Vec<PathBuf> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.is_file())
-        .collect();
+    // The folder's files and those of its folders (the BT.CPP trees a
+    // rules file imports from `trees/`).
+    let mut names: Vec<PathBuf> = Vec::new();
+    for p in std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().path()) {
+        if p.is_file() {
+            names.push(p);
+        } else if p.is_dir() {
+            names.extend(
+                std::fs::read_dir(&p)
+                    .unwrap()
+                    .map(|e| e.unwrap().path())
+                    .filter(|p| p.is_file()),
+            );
+        }
+    }
     names.extend(extra);
     names.extend([plan.to_path_buf(), problem.to_path_buf()]);
     names.sort();

@@ -52,6 +52,7 @@ pub fn check_item(
                 captures: Vec::new(),
                 basic: basic_ports(&t.ports),
                 in_plan: false,
+                imported: false,
                 diags: Vec::new(),
             };
             for b in &t.body {
@@ -69,6 +70,7 @@ pub fn check_item(
                 captures: Vec::new(),
                 basic: Vec::new(),
                 in_plan: true,
+                imported: false,
                 diags: Vec::new(),
             };
             for b in body {
@@ -105,6 +107,25 @@ pub fn check_item(
             Vec::new()
         }
     }
+}
+
+/// A tree imported from BT.CPP XML, checked as a `tree` of the importing
+/// rules (its spans are the XML file's).
+pub fn check_imported_tree(t: &TreeDecl, decls: &Decls, ctx: Option<DomainCtx>) -> Vec<Diagnostic> {
+    let mut tcx = Tcx {
+        decls,
+        ctx,
+        vars: port_vars(&t.ports, ctx),
+        captures: Vec::new(),
+        basic: basic_ports(&t.ports),
+        in_plan: false,
+        imported: true,
+        diags: Vec::new(),
+    };
+    for b in &t.body {
+        tcx.template(b);
+    }
+    tcx.diags
 }
 
 fn count_steps(body: &[Template]) -> usize {

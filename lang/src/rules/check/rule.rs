@@ -138,6 +138,7 @@ pub(super) fn check_rule(r: &Rule, decls: &Decls, ctx: Option<DomainCtx>) -> Vec
             captures: captures_of(&[]),
             basic: Vec::new(),
             in_plan: false,
+            imported: false,
             diags: Vec::new(),
         };
         if let RuleBody::Template { body, .. } = &r.body {
@@ -231,6 +232,7 @@ pub(super) fn check_rule(r: &Rule, decls: &Decls, ctx: Option<DomainCtx>) -> Vec
             captures: captures.clone(),
             basic: Vec::new(),
             in_plan: false,
+            imported: false,
             diags: Vec::new(),
         };
         match &r.body {

@@ -58,6 +58,7 @@ impl Tcx<'_> {
                 args,
                 scripts,
                 span,
+                ..
             } => {
                 self.call(name, args, *span);
                 self.script_attrs(scripts);
@@ -140,6 +141,24 @@ impl Tcx<'_> {
 
     pub(super) fn call(&mut self, name: &Ident, args: &[Arg], span: Span) {
         let Some(ports) = self.decls.ports(&name.text) else {
+            if self.imported && name.text.starts_with(crate::rules::btxml::SUBTREE_PREFIX) {
+                // A <SubTree> naming no tree of its file: R073 already.
+                return;
+            }
+            if self.imported {
+                self.err(unknown_name(
+                    Diagnostic::error(
+                        codes::R_XML_NODE,
+                        name.span,
+                        format!("no palette and no declaration of the rules has the node `{}`", name.text),
+                    ),
+                    &name.text,
+                    self.decls.nodes.keys().map(String::as_str),
+                    str::to_owned,
+                    || format!("declare it in the rules (`action {}(...)`), or import a palette that has it (`import \"nodes.xml\"`)", name.text),
+                ));
+                return;
+            }
             self.err(unknown_name(
                 Diagnostic::error(
                     codes::R_UNKNOWN_NODE,

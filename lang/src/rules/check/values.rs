@@ -36,6 +36,9 @@ pub(super) struct Tcx<'a> {
     /// Tree ports of basic types (`int`, `string`, ...), as variables.
     pub(super) basic: Vec<(String, VType)>,
     pub(super) in_plan: bool,
+    /// Checking a tree imported from BT.CPP XML: a node nothing declares
+    /// is R075, whose hint names palettes.
+    pub(super) imported: bool,
     pub(super) diags: Vec<Diagnostic>,
 }
 

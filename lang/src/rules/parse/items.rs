@@ -59,7 +59,9 @@ fn import<'t, I: Tokens<'t>, R: ItemError<'t, I> + 't>(
     let sp = spans(file);
     kw("import")
         .ignore_then(choice((
-            strlit(file).map(|path| ImportTarget::Path { path }),
+            strlit(file)
+                .then(kw("as").ignore_then(ident(file)).or_not())
+                .map(|(path, alias)| ImportTarget::Path { path, alias }),
             kw("std")
                 .ignore_then(punct("::"))
                 .ignore_then(ident(file))

@@ -159,6 +159,7 @@ fn call<'t, I: Tokens<'t>, R: ItemError<'t, I> + 't>(
             name,
             args,
             scripts: scripts.unwrap_or_default(),
+            label: None,
             span: sp(e.span()),
         })
 }
