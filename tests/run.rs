@@ -345,12 +345,17 @@ fn commands_of(args: &[&str], what: &str) -> Vec<serde_json::Value> {
     all.push("--controller");
     let s = summary_of(&all, 0);
     assert_eq!(s["goal_reached"], true, "{what}");
-    s["commands"]
+    let mut commands: Vec<serde_json::Value> = s["commands"]
         .as_array()
         .expect("a controller run lists its commands")
         .iter()
         .map(|c| serde_json::json!([c["step"], c["command"], c["args"]]))
-        .collect()
+        .collect();
+    // The controller is a thread: which of two concurrent steps' commands
+    // it is handed first depends on when the other's completion arrived.
+    // Each step's own commands keep their order (a stable sort).
+    commands.sort_by_key(|c| c[0].as_u64());
+    commands
 }
 
 /// The rules compiled to the JSON IR, to BT.CPP XML and to inlined XML each
