@@ -120,7 +120,11 @@ fn peer(name: &str, domain: &Path, problem: &Path, limit: Duration) -> Outcome {
     if let Some(s) = v["skipped"].as_str() {
         return Outcome::Skipped(s.to_owned());
     }
-    match (v["makespan"].as_f64(), v["seconds"].as_f64(), v["plan"].as_array()) {
+    match (
+        v["makespan"].as_f64(),
+        v["seconds"].as_f64(),
+        v["plan"].as_array(),
+    ) {
         (Some(makespan), Some(seconds), Some(steps)) => Outcome::Plan {
             makespan,
             seconds,

@@ -144,9 +144,8 @@ fn scratch(tag: &str) -> PathBuf {
     dir
 }
 
-/// `btc plan`, the plan to stdout (as `btc plan D P > plan`; `-o` would
-/// add the two `fsync`s of a durable write, which the peers do not do):
-/// time and plan cost.
+/// `btc plan`, the plan to stdout (as `btc plan D P > plan`): time and
+/// plan cost.
 fn btc_plan(c: &Case) -> Option<(Duration, Option<f64>)> {
     btc_plan_with(btc(), c)
 }

@@ -142,24 +142,55 @@ pub fn load_job(
         problem: problem.map(FilePath::new),
         domain: domain.map(FilePath::new),
     };
-    let loaded = project::load_job(&mut database, &files::Disk, &paths)
+    let loaded = project::load_job_files(&mut database, &files::Disk, &paths)
         .map_err(files::unreadable_job_file)?;
     let job = loaded.job;
     let plan_file = db::file_id(&database, job.plan(&database));
-    let mut diagnostics: Vec<Diagnostic> = db::job_diagnostics(&database, job)
+    // Replaying a long plan (a timed one especially) takes as long as
+    // lowering it: on a second core the tree is lowered meanwhile,
+    // memoized for `tree_of` (and unused if the job is refused).
+    let lowering = (!planned).then(|| database.clone());
+    let mut diagnostics: Vec<Diagnostic> = std::thread::scope(|s| {
+        if let Some(lowering) = lowering {
+            s.spawn(move || {
+                let _ = db::compile(&lowering, job);
+            });
+        }
+        diagnostics_of(&database, job, planned, plan_file, allow_invalid_plan)
+    });
+    if project::load_neighbours_if_wanted(&mut database, &files::Disk, &loaded, &paths) {
+        // The replay's advice names the problems beside the plan it fits.
+        diagnostics = diagnostics_of(&database, job, planned, plan_file, allow_invalid_plan);
+    }
+    Ok(Job {
+        db: database,
+        loaded,
+        diagnostics,
+    })
+}
+
+/// What checking the job and replaying its plan say.
+fn diagnostics_of(
+    database: &Database,
+    job: db::CompileJob,
+    planned: bool,
+    plan_file: btc_pddl::source::FileId,
+    allow_invalid_plan: bool,
+) -> Vec<Diagnostic> {
+    let mut diagnostics: Vec<Diagnostic> = db::job_diagnostics(database, job)
         .iter()
         // A plan still to be made has no steps yet: nothing to say about it.
         .filter(|d| !(planned && d.span.file == plan_file && d.code.starts_with('L')))
         .cloned()
         .collect();
     project::suggest_paths(
-        &database,
+        database,
         &files::Disk,
-        job.rules(&database),
+        job.rules(database),
         &mut diagnostics,
     );
     if !planned {
-        for d in project::fit::plan_validation(&database, job) {
+        for d in project::fit::plan_validation(database, job) {
             let mut d = d.clone();
             if allow_invalid_plan {
                 d.severity = Severity::Warning;
@@ -167,11 +198,7 @@ pub fn load_job(
             diagnostics.push(d);
         }
     }
-    Ok(Job {
-        db: database,
-        loaded,
-        diagnostics,
-    })
+    diagnostics
 }
 
 /// The job's tree, or `None` with what refuses it added to the job's

@@ -419,13 +419,11 @@ pub fn target_dir(name: &str) -> PathBuf {
 
 // Inputs shared by the benchmarks.
 
-/// A valid ARIAC plan of exactly `steps` steps: the robot carries the red
-/// battery between bin1 and agv1, ending with it on agv1 when
-/// `steps % 6 == 4` (as for 100,000).
 /// A valid timed plan of `steps` steps for `examples/p3_assembler` in the
 /// P3 generator's input format: the example's first four steps, then a
 /// cycle of picks and places at the assembly station (with a self-move the
-/// rules skip, a wait and a round trip), times increasing.
+/// rules skip, a wait and a round trip), times increasing; from 6 steps on
+/// the last one takes the robot home, so the plan reaches the goal.
 pub fn long_p3_plan(steps: usize) -> String {
     let start = [
         ("MOVE_TO robot1 home tool_rack", 2.0),
@@ -442,7 +440,11 @@ pub fn long_p3_plan(steps: usize) -> String {
     for (a, d) in start.iter().take(steps) {
         push(&mut out, a, *d);
     }
-    for i in 0..steps.saturating_sub(start.len()) {
+    // Three cycles do each operation once; the goal also wants the robot
+    // home at the end.
+    let home = steps > start.len() + 18;
+    let cycle = steps.saturating_sub(start.len() + usize::from(home));
+    for i in 0..cycle {
         let op = 1 + (i / 6) % 3;
         match i % 6 {
             0 => push(
@@ -461,9 +463,20 @@ pub fn long_p3_plan(steps: usize) -> String {
             _ => push(&mut out, "MOVE_TO robot1 tool_rack assembly_station", 2.0),
         }
     }
+    if home {
+        let from = if cycle % 6 == 5 {
+            "tool_rack"
+        } else {
+            "assembly_station"
+        };
+        push(&mut out, &format!("MOVE_TO robot1 {from} home"), 2.0);
+    }
     out
 }
 
+/// A valid ARIAC plan of exactly `steps` steps: the robot carries the red
+/// battery between bin1 and agv1, ending with it on agv1 when
+/// `steps % 6 == 4` (as for 100,000).
 pub fn long_ariac_plan(steps: usize) -> String {
     let mut s = String::from("(move floor_robot curr_position bin1)\n");
     let cycle = [

@@ -95,6 +95,19 @@ pub fn load_job(
     loader: &dyn FileLoader,
     paths: &JobPaths,
 ) -> Result<LoadedJob, Unreadable> {
+    let loaded = load_job_files(db, loader, paths)?;
+    load_neighbours_if_wanted(db, loader, &loaded, paths);
+    Ok(loaded)
+}
+
+/// [`load_job`] without the plan's neighbours: a caller that works on the
+/// job meanwhile (on another thread) loads them after, with
+/// [`load_neighbours_if_wanted`].
+pub fn load_job_files(
+    db: &mut Database,
+    loader: &dyn FileLoader,
+    paths: &JobPaths,
+) -> Result<LoadedJob, Unreadable> {
     let rules = load_rules(db, loader, &paths.rules).map_err(|why| Unreadable {
         path: paths.rules.clone(),
         why,
@@ -114,10 +127,22 @@ pub fn load_job(
     };
     let given = problem.and_then(|(f, c)| (c != ProblemChoice::NamedByRules).then_some(f));
     let job = CompileJob::new(db, rules, plan, given, domain);
-    if plan_path.is_some() && wants_neighbours(db, job) {
-        load_neighbours(db, loader, plan);
-    }
     Ok(LoadedJob { job, problem })
+}
+
+/// Loads the problems beside the plan when it does not fit its own (so
+/// the diagnostics can say which one it is for); whether it did.
+pub fn load_neighbours_if_wanted(
+    db: &mut Database,
+    loader: &dyn FileLoader,
+    loaded: &LoadedJob,
+    paths: &JobPaths,
+) -> bool {
+    let wanted = matches!(paths.plan, PlanSource::File(_)) && wants_neighbours(db, loaded.job);
+    if wanted {
+        load_neighbours(db, loader, loaded.job.plan(db));
+    }
+    wanted
 }
 
 fn find_problem(

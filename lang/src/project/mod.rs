@@ -16,7 +16,10 @@ pub mod refs;
 pub mod report;
 
 pub use disk::DiskLoader;
-pub use job::{load_job, JobPaths, LoadedJob, PlanSource, ProblemChoice};
+pub use job::{
+    load_job, load_job_files, load_neighbours_if_wanted, JobPaths, LoadedJob, PlanSource,
+    ProblemChoice,
+};
 pub use load::{load_file, load_references, load_rules, read_file};
 pub use loader::{FileLoader, Loaded, MemoryLoader, ReadFailure};
 pub use nearby::suggest_paths;

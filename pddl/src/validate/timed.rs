@@ -69,6 +69,8 @@ pub(super) fn validate_timed(
         started: 0,
         epsilon,
         changes: Changes::default(),
+        binding: Vec::new(),
+        events: Vec::new(),
     };
     match replay.run() {
         Ok(()) => finish(world, problem, plan, replay.state, steps.len(), Vec::new()),
@@ -95,6 +97,10 @@ struct TimedReplay<'a> {
     started: usize,
     epsilon: f64,
     changes: Changes,
+    /// Buffers reused from event to event (a long plan has hundreds of
+    /// thousands): a step's arguments as a binding, a happening's events.
+    binding: Vec<u32>,
+    events: Vec<Event>,
 }
 
 /// An event with what it needs at its happening.
@@ -136,7 +142,8 @@ impl<'a> TimedReplay<'a> {
     /// first, then starts in plan order.
     fn happening(&mut self, now: f64) -> Vec<Event> {
         let window = now + self.epsilon / 10.0;
-        let mut events = Vec::new();
+        let mut events = std::mem::take(&mut self.events);
+        events.clear();
         let mut i = 0;
         while i < self.running.len() {
             if self.running[i].end <= window {
@@ -167,26 +174,27 @@ impl<'a> TimedReplay<'a> {
         events
     }
 
-    fn apply_happening(&mut self, now: f64, events: Vec<Event>) -> Result<(), Diagnostic> {
+    fn apply_happening(&mut self, now: f64, mut events: Vec<Event>) -> Result<(), Diagnostic> {
         let world = self.world;
         let mut ready = Vec::with_capacity(events.len());
         let concurrent = events.len() > 1;
-        for mut event in events {
+        for mut event in events.drain(..) {
             let g = &self.steps[event.step];
             let action = self.actions.get(g.action)?;
             if event.phase == Phase::Instant && action.ast.durative {
                 event.phase = Phase::Start;
             }
             let duration = self.duration(&event, &action)?;
-            let mut b = g.args.to_vec();
             let c = &*action.compiled;
             let (conds, effects): (&[Cond], &[Eff]) = match event.phase {
                 Phase::Start => (&c.pre_start, &c.eff_start),
                 Phase::End => (&c.pre_end, &c.eff_end),
                 Phase::Instant => (&c.pre_start, &c.eff_end),
             };
-            let footprint = concurrent
-                .then(|| Footprint::of(world, &self.state, conds, effects, &mut b, duration));
+            let footprint = concurrent.then(|| {
+                let mut b = g.args.to_vec();
+                Footprint::of(world, &self.state, conds, effects, &mut b, duration)
+            });
             ready.push(Ready {
                 event,
                 action,
@@ -194,6 +202,7 @@ impl<'a> TimedReplay<'a> {
                 footprint,
             });
         }
+        self.events = events;
         self.check_interference(now, &ready)?;
         for r in &ready {
             self.check_conditions(r)?;
@@ -308,7 +317,7 @@ impl<'a> TimedReplay<'a> {
             Phase::End => (&c.pre_end, &a.pre_end, "its `at end` condition"),
             Phase::Instant => (&c.pre_start, &a.pre_start, "its precondition"),
         };
-        let mut b = self.steps[r.event.step].args.to_vec();
+        let mut b = self.binding_of(r.event.step);
         for (cond, f) in conds.iter().zip(written) {
             if !self.world.holds(&self.state, cond, &mut b, r.duration) {
                 let (why, path) = self.world.why_not(&self.state, cond, &mut b, r.duration);
@@ -322,6 +331,7 @@ impl<'a> TimedReplay<'a> {
                     .with_label(logic::span_at(f, &path), "this condition fails"));
             }
         }
+        self.binding = b;
         Ok(())
     }
 
@@ -331,11 +341,12 @@ impl<'a> TimedReplay<'a> {
             Phase::Start => &c.eff_start,
             Phase::End | Phase::Instant => &c.eff_end,
         };
-        let mut b = self.steps[r.event.step].args.to_vec();
+        let mut b = self.binding_of(r.event.step);
         for e in effects {
             self.world
                 .collect(&self.state, e, &mut b, r.duration, &mut self.changes);
         }
+        self.binding = b;
         if let Some(err) = self.changes.numeric_errors.first() {
             let d = self
                 .error(
@@ -362,6 +373,9 @@ impl<'a> TimedReplay<'a> {
             let g = &self.steps[r.step];
             let action = self.actions.get(g.action)?;
             let (c, a) = (&*action.compiled, action.ast);
+            if c.pre_over_all.is_empty() {
+                continue;
+            }
             let mut b = g.args.to_vec();
             for (cond, f) in c.pre_over_all.iter().zip(&a.pre_over_all) {
                 if world.holds(&self.state, cond, &mut b, Some(r.duration)) {
@@ -410,6 +424,15 @@ impl<'a> TimedReplay<'a> {
             }
         }
         Ok(())
+    }
+
+    /// Step `step`'s arguments as a binding, in the reused buffer (put it
+    /// back in `self.binding` after use).
+    fn binding_of(&mut self, step: usize) -> Vec<u32> {
+        let mut b = std::mem::take(&mut self.binding);
+        b.clear();
+        b.extend_from_slice(&self.steps[step].args);
+        b
     }
 
     /// "the start of step 3 `(move r2d2 wp1 wp2)`".
