@@ -261,7 +261,7 @@ fn the_embedders_leaves_tick_in_the_run_and_in_the_loop() {
     // Every `Grasp` is the embedder's: RUNNING once, then SUCCESS.
     let calls = Rc::new(Cell::new(0));
     let c = Rc::clone(&calls);
-    let handler = Box::new(move |call: &btc_api::ActionCall<'_>| {
+    let handler: btc_api::Handler<'_> = Box::new(move |call: &btc_api::ActionCall<'_>| {
         c.set(c.get() + 1);
         if call.starting {
             Status::Running
@@ -310,6 +310,77 @@ fn the_embedders_leaves_tick_in_the_run_and_in_the_loop() {
         r.replans[0].action.as_deref(),
         Some("step 4: (place floor_robot battery_red agv1)")
     );
+}
+
+/// A leaf still RUNNING when the run stops is halted, and its halt handler
+/// hears of it (BT.CPP's `onHalted`, where a client cancels its goal),
+/// with the ports of its last tick; in the run and in the agent's loop.
+#[test]
+fn a_halted_leaf_hears_of_its_halt_in_the_run_and_in_the_loop() {
+    let mut project = open("ariac");
+    let plan = project.plan(None).unwrap();
+    let tree = project.compile(&plan, None).unwrap();
+    let halted: Rc<std::cell::RefCell<Vec<String>>> = Rc::default();
+    let h = Rc::clone(&halted);
+    let leaves = btc_api::Leaves::new()
+        // The gripper never finishes.
+        .action("Grasp", |_: &btc_api::ActionCall<'_>| Status::Running)
+        .on_halt("Grasp", move |call: &btc_api::ActionCall<'_>| {
+            let part = match call.port("part") {
+                Some(btc_api::Value::Text(t)) => t.to_string(),
+                other => format!("{other:?}"),
+            };
+            h.borrow_mut().push(part);
+        });
+    let options = RunOptions {
+        max_ticks: 40,
+        ..RunOptions::default()
+    };
+    let report = tree.run(&options, leaves, None).unwrap();
+    assert_eq!(report.status, Status::Running, "{report:#?}");
+    let grasped = plan
+        .steps
+        .iter()
+        .find(|s| s.action == "grasp")
+        .expect("the plan grasps");
+    assert_eq!(halted.borrow().len(), 1, "{:?}", halted.borrow());
+    assert!(
+        grasped.args.contains(&halted.borrow()[0]),
+        "{:?} halted, {grasped:?} grasps",
+        halted.borrow()
+    );
+    // A leaf that never halts is not told anything.
+    let quiet = Rc::new(Cell::new(0));
+    let q = Rc::clone(&quiet);
+    let leaves = btc_api::Leaves::new().on_halt("Grasp", move |_| q.set(q.get() + 1));
+    assert!(tree
+        .run(&RunOptions::default(), leaves, None)
+        .unwrap()
+        .success());
+    assert_eq!(quiet.get(), 0);
+    // An id no leaf has is an error, as for a tick handler.
+    let leaves = btc_api::Leaves::new().on_halt("Grasps", |_| {});
+    let e = tree.run(&RunOptions::default(), leaves, None).unwrap_err();
+    assert!(e.to_string().contains("`Grasps`"), "{e}");
+    // The agent's loop: every attempt's stuck `Grasp` is halted when its
+    // tree stops at the tick limit.
+    let mut agent = Agent::new(open("ariac"), None);
+    let stops = Rc::new(Cell::new(0));
+    let s = Rc::clone(&stops);
+    agent
+        .leaf("Grasp", |_| Status::Running)
+        .on_halt("Grasp", move |_| s.set(s.get() + 1));
+    let r = agent
+        .run(
+            &AgentOptions {
+                run: options,
+                max_replans: 0,
+            },
+            None,
+        )
+        .unwrap();
+    assert!(!r.goal_reached, "{r:#?}");
+    assert_eq!(stops.get(), r.attempts.len(), "{r:#?}");
 }
 
 #[test]

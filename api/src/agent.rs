@@ -9,7 +9,7 @@ use crate::diagnostic::{convert, Diagnostic, Error};
 use crate::executor::{Adapter, Executor};
 use crate::faults::Faults;
 use crate::project::Project;
-use crate::tree::{Handler, RunOptions};
+use crate::tree::{HaltHandler, Handler, RunOptions};
 use btc_agent::{LoopError, LoopOptions};
 use btc_runtime::{ActionCall, Engine, Status};
 use std::cell::RefCell;
@@ -57,11 +57,13 @@ pub struct AgentReport {
 }
 
 type Shared = Rc<RefCell<Handler<'static>>>;
+type SharedHalt = Rc<RefCell<HaltHandler<'static>>>;
 
 pub struct Agent {
     project: Project,
     problem: Option<PathBuf>,
     leaves: Vec<(String, Shared)>,
+    halts: Vec<(String, SharedHalt)>,
 }
 
 impl Agent {
@@ -71,6 +73,7 @@ impl Agent {
             project,
             problem: problem.map(Path::to_path_buf),
             leaves: Vec::new(),
+            halts: Vec::new(),
         }
     }
 
@@ -89,6 +92,20 @@ impl Agent {
         self
     }
 
+    /// Makes `halted` hear of every halt of a RUNNING action leaf with
+    /// node id `id`, in every attempt (BT.CPP's `onHalted`: cancel the goal
+    /// the leaf sent). A fault the loop replans after halts what was
+    /// running; so does a tree the tick limit stops.
+    pub fn on_halt(
+        &mut self,
+        id: impl Into<String>,
+        halted: impl FnMut(&ActionCall<'_>) + 'static,
+    ) -> &mut Self {
+        self.halts
+            .push((id.into(), Rc::new(RefCell::new(Box::new(halted)))));
+        self
+    }
+
     pub fn project(&self) -> &Project {
         &self.project
     }
@@ -100,17 +117,25 @@ impl Agent {
         options: &AgentOptions,
         faults: Option<&Faults>,
     ) -> Result<AgentReport, Error> {
-        for (id, _) in &self.leaves {
+        let ids = self.leaves.iter().map(|(id, _)| id);
+        for id in ids.chain(self.halts.iter().map(|(id, _)| id)) {
             self.project.declared_action(id)?;
         }
         let (db, job) = self.project.loop_job(self.problem.as_deref())?;
         let opts = loop_options(options);
-        let leaves = &self.leaves;
+        let (leaves, halts) = (&self.leaves, &self.halts);
         let mut install = |engine: &mut Engine<'_>| {
+            // A plan may use none of an id's leaves: that is fine.
             for (id, h) in leaves {
                 let h = Rc::clone(h);
-                // A plan may use none of this id's leaves: that is fine.
                 engine.set_action_handler(
+                    id,
+                    Box::new(move |call: &ActionCall<'_>| (h.borrow_mut())(call)),
+                );
+            }
+            for (id, h) in halts {
+                let h = Rc::clone(h);
+                engine.set_halt_handler(
                     id,
                     Box::new(move |call: &ActionCall<'_>| (h.borrow_mut())(call)),
                 );

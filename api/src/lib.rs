@@ -38,7 +38,10 @@ pub use executor::{AttemptInput, Executed, Executor, Record, ReportedFault};
 pub use faults::Faults;
 pub use plan::{Plan, Step};
 pub use project::{Project, DOMAIN_TEXT, PROBLEM_TEXT, RULES_TEXT};
-pub use tree::{Handler, NodeInfo, PortInfo, RunOptions, RunReport, StepEvent, Target, Tree};
+pub use tree::{
+    HaltHandler, Handler, Leaves, NodeInfo, PortInfo, RunOptions, RunReport, StepEvent, Target,
+    Tree,
+};
 
 /// btc's version.
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");

@@ -77,6 +77,55 @@ impl Default for RunOptions {
 /// A leaf the embedder implements, for every action leaf of one node id.
 pub type Handler<'h> = Box<dyn FnMut(&ActionCall<'_>) -> Status + 'h>;
 
+/// Told that a RUNNING leaf was halted (a reactive condition failed above
+/// it, a Parallel finished, the run stopped at its tick limit): BT.CPP's
+/// `onHalted`, where an action client cancels its goal. The call names the
+/// leaf and its ports as its last tick saw them.
+pub type HaltHandler<'h> = Box<dyn FnMut(&ActionCall<'_>) + 'h>;
+
+/// The embedder's leaves for [`Tree::run`]: per node id, what ticks its
+/// action leaves and what hears of their halts.
+#[derive(Default)]
+pub struct Leaves<'h> {
+    tick: Vec<(String, Handler<'h>)>,
+    halt: Vec<(String, HaltHandler<'h>)>,
+}
+
+impl<'h> Leaves<'h> {
+    pub fn new() -> Leaves<'h> {
+        Leaves::default()
+    }
+
+    /// `tick` ticks every action leaf with node id `id`.
+    pub fn action(
+        mut self,
+        id: impl Into<String>,
+        tick: impl FnMut(&ActionCall<'_>) -> Status + 'h,
+    ) -> Leaves<'h> {
+        self.tick.push((id.into(), Box::new(tick)));
+        self
+    }
+
+    /// `halted` hears of every halt of a RUNNING leaf with node id `id`.
+    pub fn on_halt(
+        mut self,
+        id: impl Into<String>,
+        halted: impl FnMut(&ActionCall<'_>) + 'h,
+    ) -> Leaves<'h> {
+        self.halt.push((id.into(), Box::new(halted)));
+        self
+    }
+}
+
+impl<'h> From<Vec<(String, Handler<'h>)>> for Leaves<'h> {
+    fn from(tick: Vec<(String, Handler<'h>)>) -> Leaves<'h> {
+        Leaves {
+            tick,
+            halt: Vec::new(),
+        }
+    }
+}
+
 /// A step started or ended, at a tick.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 pub struct StepEvent {
@@ -207,14 +256,16 @@ impl Tree {
     }
 
     /// Runs the tree in btc's engine against the problem's initial state:
-    /// action leaves whose id `handlers` names tick the embedder's code,
-    /// the others are simulated as `btc run` simulates them.
+    /// action leaves whose id `leaves` names tick the embedder's code (a
+    /// `Vec` of `(id, handler)` or a [`Leaves`], which also takes halt
+    /// handlers), the others are simulated as `btc run` simulates them.
     pub fn run<'h>(
         &self,
         options: &RunOptions,
-        handlers: Vec<(String, Handler<'h>)>,
+        leaves: impl Into<Leaves<'h>>,
         faults: Option<&Faults>,
     ) -> Result<RunReport, Error> {
+        let leaves = leaves.into();
         let world = World::new(self.ir.world.clone()).map_err(|m| {
             Error::one(Diagnostic::without_place(
                 btc_pddl::diagnostic::codes::X_WORLD.id,
@@ -229,16 +280,24 @@ impl Tree {
         };
         let tree_error = |e: btc_runtime::LoadError| crate::faults::load_error(&e, &self.ir.plan);
         let mut engine = Engine::build(&doc, Some(Kb::new(&world)), opts).map_err(tree_error)?;
-        for (id, h) in handlers {
+        let unknown = |id: &str| {
+            Error::one(
+                Diagnostic::without_place(
+                    btc_pddl::diagnostic::codes::X_UNKNOWN_NODE.id,
+                    format!("no action leaf of this tree has the id `{id}`"),
+                    &self.ir.rules,
+                )
+                .hint("a handler takes the action leaves of one node id the rules declare"),
+            )
+        };
+        for (id, h) in leaves.tick {
             if engine.set_action_handler(&id, h) == 0 {
-                return Err(Error::one(
-                    Diagnostic::without_place(
-                        btc_pddl::diagnostic::codes::X_UNKNOWN_NODE.id,
-                        format!("no action leaf of this tree has the id `{id}`"),
-                        &self.ir.rules,
-                    )
-                    .hint("a handler takes the action leaves of one node id the rules declare"),
-                ));
+                return Err(unknown(&id));
+            }
+        }
+        for (id, h) in leaves.halt {
+            if engine.set_halt_handler(&id, h) == 0 {
+                return Err(unknown(&id));
             }
         }
         if let Some(f) = faults {
