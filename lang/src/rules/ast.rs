@@ -118,6 +118,15 @@ pub struct PortDecl {
     pub span: Span,
 }
 
+/// Ports as `(name, type, out)`, as tests compare them.
+#[cfg(test)]
+pub fn port_triples(ports: &[PortDecl]) -> Vec<(&str, &str, bool)> {
+    ports
+        .iter()
+        .map(|p| (p.name.text.as_str(), p.ty.text.as_str(), p.out))
+        .collect()
+}
+
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct NodeDecl {
     pub kind: NodeKind,

@@ -301,11 +301,7 @@ mod tests {
         assert_eq!(names, ["MoveTo", "Ready", "Pose"]);
         let m = decls[0];
         assert_eq!(m.kind, NodeKind::Action);
-        let ports: Vec<(&str, &str, bool)> = m
-            .ports
-            .iter()
-            .map(|p| (p.name.text.as_str(), p.ty.text.as_str(), p.out))
-            .collect();
+        let ports = crate::rules::ast::port_triples(&m.ports);
         assert_eq!(
             ports,
             [

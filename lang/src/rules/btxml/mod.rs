@@ -133,11 +133,7 @@ mod tests {
             .iter()
             .find(|t| t.name.text == "TransportTree")
             .unwrap();
-        let ports: Vec<(&str, &str, bool)> = main
-            .ports
-            .iter()
-            .map(|p| (p.name.text.as_str(), p.ty.text.as_str(), p.out))
-            .collect();
+        let ports = crate::rules::ast::port_triples(&main.ports);
         // Through `_autoremap`, the called tree's ports; `arrived` only
         // written by an output port.
         assert_eq!(

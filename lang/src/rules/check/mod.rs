@@ -45,21 +45,8 @@ pub fn check_item(
         Item::Rule(r) => check_rule(r, decls, ctx),
         Item::Node(n) => check_node(n, ctx),
         Item::Tree(t) => {
-            let mut tcx = Tcx {
-                decls,
-                ctx,
-                vars: port_vars(&t.ports, ctx),
-                captures: Vec::new(),
-                basic: basic_ports(&t.ports),
-                in_plan: false,
-                imported: false,
-                diags: Vec::new(),
-            };
-            for b in &t.body {
-                tcx.template(b);
-            }
             let mut diags = port_type_diags(&t.ports, ctx);
-            diags.extend(tcx.diags);
+            diags.extend(tree_body_diags(t, decls, ctx, false));
             diags
         }
         Item::Plan { body, span } => {
@@ -112,6 +99,16 @@ pub fn check_item(
 /// A tree imported from BT.CPP XML, checked as a `tree` of the importing
 /// rules (its spans are the XML file's).
 pub fn check_imported_tree(t: &TreeDecl, decls: &Decls, ctx: Option<DomainCtx>) -> Vec<Diagnostic> {
+    tree_body_diags(t, decls, ctx, true)
+}
+
+/// What checking a tree's body against its ports says.
+fn tree_body_diags(
+    t: &TreeDecl,
+    decls: &Decls,
+    ctx: Option<DomainCtx>,
+    imported: bool,
+) -> Vec<Diagnostic> {
     let mut tcx = Tcx {
         decls,
         ctx,
@@ -119,7 +116,7 @@ pub fn check_imported_tree(t: &TreeDecl, decls: &Decls, ctx: Option<DomainCtx>) 
         captures: Vec::new(),
         basic: basic_ports(&t.ports),
         in_plan: false,
-        imported: true,
+        imported,
         diags: Vec::new(),
     };
     for b in &t.body {
