@@ -2,15 +2,13 @@
 
 The module btc writes for `--emit pytrees --runtime import` is the tree as
 data (the world, the plan's steps, the leaf classes, the rule trees, the
-root) over btc's py_trees runtime. Here that text is read as data: each
-assignment's value is a Python literal, read with `ast.literal_eval`, so no
-generated code runs. Leaf classes come from the caller's `nodes` where it
+root) over btc's py_trees runtime. btc's extension reads that text as
+data (each assignment's value is a Python literal), so no generated code
+runs. Leaf classes come from the caller's `nodes` where it
 names them (a module or a mapping of node id -> class) and are btc's own
 otherwise: simulated actions, and conditions that evaluate the formula the
 rules define on the knowledge base.
 """
-
-import ast
 
 from . import btc_runtime
 
@@ -18,45 +16,22 @@ _BASES = {"Action": btc_runtime.Action, "Condition": btc_runtime.Condition}
 
 
 class TreeData:
-    """What a generated module holds, as values."""
+    """What a generated module holds, as values: `world` (the keywords of
+    its `World`), `classes` (`(node id, class name)` pairs), `defined`
+    (class name -> `(base, attributes)` of the leaf classes it defines)
+    and `literals` (`SHAPES`, `STEPS`, `TREES`, `ROOT`, ...). btc's
+    extension reads them from the module's text (`btc._btc._module_data`)."""
 
-    def __init__(self, text):
-        self.world = {}
-        self.literals = {}
-        self.classes = []
-        self.defined = {}
-        for node in ast.parse(text).body:
-            if isinstance(node, ast.ClassDef):
-                self.defined[node.name] = _class_of(node)
-            elif isinstance(node, ast.Assign) and len(node.targets) == 1:
-                name = getattr(node.targets[0], "id", None)
-                self._assign(name, node.value)
-        self.shapes = self.literals["SHAPES"]
-        self.steps = self.literals["STEPS"]
-        self.trees = self.literals["TREES"]
-        self.root = self.literals["ROOT"]
-        self.max_ticks = self.literals.get("MAX_TICKS", 10000)
-
-    def _assign(self, name, value):
-        if name == "WORLD" and isinstance(value, ast.Call):
-            self.world = {k.arg: ast.literal_eval(k.value) for k in value.keywords}
-        elif name == "CLASSES" and isinstance(value, ast.Tuple):
-            # ((node id, class name), ...): the class is a name, not a literal.
-            for pair in value.elts:
-                ident, cls = pair.elts
-                self.classes.append((ast.literal_eval(ident), cls.id))
-        elif name in ("SHAPES", "STEPS", "TREES", "ROOT", "MAX_TICKS", "NODE_CLASS_NAMES"):
-            self.literals[name] = ast.literal_eval(value)
-
-
-def _class_of(node):
-    """A generated leaf class: its base and its `NODE_ID` and `FORMULA`."""
-    base = node.bases[0].id
-    attrs = {}
-    for stmt in node.body:
-        if isinstance(stmt, ast.Assign) and len(stmt.targets) == 1:
-            attrs[stmt.targets[0].id] = ast.literal_eval(stmt.value)
-    return base, attrs
+    def __init__(self, world, classes, defined, literals):
+        self.world = world
+        self.classes = classes
+        self.defined = defined
+        self.literals = literals
+        self.shapes = literals["SHAPES"]
+        self.steps = literals["STEPS"]
+        self.trees = literals["TREES"]
+        self.root = literals["ROOT"]
+        self.max_ticks = literals.get("MAX_TICKS", 10000)
 
 
 def _user_class(nodes, ident, name):

@@ -4,6 +4,7 @@
 //! diagnostics, never a crash of the host process.
 
 mod agent;
+mod module_data;
 
 use btc_api as api;
 use pyo3::create_exception;
@@ -212,10 +213,11 @@ impl Tree {
             return Ok(d.bind(py).clone());
         }
         let text = self.pytrees_module(py)?;
+        let values = module_data::read(py, &text)?;
         let d = py
             .import("btc._pytrees")?
             .getattr("TreeData")?
-            .call1((text,))?;
+            .call((), Some(&values))?;
         let _ = self.data.set(d.clone().unbind());
         Ok(d)
     }
@@ -372,6 +374,13 @@ fn plan(py: Python<'_>, domain: PathBuf, problem: PathBuf) -> PyResult<Plan> {
 
 /// The `btc` command (`args`: the command line, program name first): its
 /// exit status. What it prints goes to this process's stdout and stderr.
+/// The data of a py_trees module btc wrote, as `btc._pytrees.TreeData`'s
+/// keyword arguments (what `Tree.to_py_trees` builds from).
+#[pyfunction]
+fn _module_data<'py>(py: Python<'py>, text: &str) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+    module_data::read(py, text)
+}
+
 #[pyfunction]
 fn _main(py: Python<'_>, args: Vec<std::ffi::OsString>) -> u8 {
     // Long commands (a trial, the language server) must not hold the GIL.
@@ -389,5 +398,6 @@ fn _btc(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Project>()?;
     m.add_function(wrap_pyfunction!(plan, m)?)?;
     m.add_function(wrap_pyfunction!(_main, m)?)?;
+    m.add_function(wrap_pyfunction!(_module_data, m)?)?;
     Ok(())
 }
