@@ -53,10 +53,25 @@ def leaf_classes(data, nodes=None):
             out.append((ident, user))
         elif cls in data.defined:
             base, attrs = data.defined[cls]
-            out.append((ident, type(cls, (_BASES[base],), dict(attrs))))
+            out.append((ident, _defined_class(cls, base, attrs)))
         else:
             out.append((ident, getattr(btc_runtime, cls)))
     return out
+
+
+_DEFINED = {}
+
+
+def _defined_class(name, base, attrs):
+    """The class a module defines, made once per content: an agent builds a
+    tree per plan from the same rules, and a class made anew each time
+    would be a new type to every `isinstance` and `issubclass` cache."""
+    key = (name, base, tuple(sorted(attrs.items())))
+    try:
+        return _DEFINED[key]
+    except KeyError:
+        cls = _DEFINED[key] = type(name, (_BASES[base],), dict(attrs))
+        return cls
 
 
 def world(data):
