@@ -1,9 +1,13 @@
 //! The C++ agent example (`examples/embed/cpp`) built against real
 //! BehaviorTree.CPP 4.10 and btc's C API, run on the ARIAC part task, and
-//! compared with `btc run --replan --format json` on the same scenarios:
-//! each scenario fault that a node can report (one triggered by an action
-//! node, `on_action`) is injected into the example's simulated action
-//! server, whose node then reports it to btc. The attempts' plans and
+//! compared with `btc run --replan --format json` on every scenario of
+//! `examples/ariac/faults`: the example plays each scenario's fault where an
+//! agent would meet it (its action node reports an `on_action` or `on_step`
+//! fault when it starts; an `at_tick` fault, news from outside the tree, is
+//! reported before that tick by the loop's `before_tick` hook), and its
+//! simulated action server does to the robot what the fault says (a
+//! dropped part, a robot down or paused for the fault's duration; the KB's
+//! conditions dark in a sensor blackout). The attempts' plans and
 //! statuses, the steps each attempt started (in order), the faults, the
 //! replans and the goal verdict must be those of `btc run --replan`, and
 //! the final KB that of the same loop with btc's engine executing. The example's node
@@ -44,43 +48,67 @@ fn example() -> Option<PathBuf> {
     Some(build.join("ariac_agent"))
 }
 
-/// The example's flags that inject a scenario's fault as a node's report,
-/// or `None` when the scenario's fault is not one a node reports.
-fn injected(scenario: &Path) -> Option<Vec<String>> {
+/// The example's flags that play a scenario's one fault as the agent would
+/// meet it: reported by the node of an action's n-th goal (`on_action`),
+/// by the first action node of a plan step or a later one (`on_step`), or
+/// from outside the tree before a tick of the loop (`at_tick`), with what
+/// the fault says. A scenario the example cannot play is an error.
+fn injected(scenario: &Path) -> Result<Vec<String>, String> {
     let text = std::fs::read_to_string(scenario).unwrap();
-    let doc: toml::Table = text.parse().unwrap();
-    let faults = doc.get("fault")?.as_array()?;
+    let doc: toml::Table = text.parse().map_err(|e| format!("not TOML: {e}"))?;
+    let faults = doc
+        .get("fault")
+        .and_then(|f| f.as_array())
+        .ok_or("no [[fault]]")?;
     let [fault] = faults.as_slice() else {
-        return None;
+        return Err(format!("{} faults; the example plays one", faults.len()));
     };
-    let fault = fault.as_table()?;
-    let action = fault.get("on_action")?.as_str()?;
-    let occurrence = fault
-        .get("occurrence")
-        .and_then(|o| o.as_integer())
-        .unwrap_or(1);
-    let mut flags = vec![
-        "--fail".to_owned(),
-        format!("{action}:{occurrence}"),
-        "--kind".to_owned(),
-        fault.get("kind")?.as_str()?.to_owned(),
-    ];
-    for key in ["robot", "part"] {
-        if let Some(v) = fault.get(key).and_then(|v| v.as_str()) {
-            flags.extend([format!("--{key}"), v.to_owned()]);
+    let fault = fault.as_table().ok_or("a fault that is not a table")?;
+    let text_of = |key: &str| -> Result<String, String> {
+        fault[key]
+            .as_str()
+            .map(str::to_owned)
+            .ok_or_else(|| format!("`{key}` is not a string"))
+    };
+    let number_of = |key: &str| -> Result<String, String> {
+        fault[key]
+            .as_integer()
+            .map(|n| n.to_string())
+            .ok_or_else(|| format!("`{key}` is not a number"))
+    };
+    let mut flags = Vec::new();
+    for key in fault.keys() {
+        let flag = |name: &str, value: String| [format!("--{name}"), value];
+        match key.as_str() {
+            "on_action" => {
+                let n = match fault.get("occurrence") {
+                    Some(_) => number_of("occurrence")?,
+                    None => "1".to_owned(),
+                };
+                flags.extend(flag("fail", format!("{}:{n}", text_of(key)?)));
+            }
+            "occurrence" => {}
+            "on_step" => flags.extend(flag("fail-step", number_of(key)?)),
+            "at_tick" => flags.extend(flag("at-tick", number_of(key)?)),
+            "kind" | "robot" | "part" | "goal" | "conditions" => {
+                flags.extend(flag(key, text_of(key)?));
+            }
+            "duration" => flags.extend(flag(key, number_of(key)?)),
+            "retract" | "add" => {
+                let list = fault[key]
+                    .as_array()
+                    .ok_or_else(|| format!("`{key}` is not a list"))?;
+                for v in list {
+                    let v = v
+                        .as_str()
+                        .ok_or_else(|| format!("`{key}` holds a non-string"))?;
+                    flags.extend(flag(key, v.to_owned()));
+                }
+            }
+            other => return Err(format!("the example has no flag for `{other}`")),
         }
     }
-    for key in ["retract", "add"] {
-        for v in fault
-            .get(key)
-            .and_then(|v| v.as_array())
-            .into_iter()
-            .flatten()
-        {
-            flags.extend([format!("--{key}"), v.as_str()?.to_owned()]);
-        }
-    }
-    Some(flags)
+    Ok(flags)
 }
 
 /// What both runs must agree on.
@@ -107,12 +135,12 @@ fn the_cpp_agent_recovers_as_btc_run_replan_does() {
     let Some(agent) = example() else { return };
     let ariac = btc_testkit::repo().join("examples/ariac");
     let rules = ariac.join("rules.btrules");
+    let scenarios = btc_testkit::sorted_entries(&ariac.join("faults"));
     let mut compared = 0;
-    for scenario in btc_testkit::sorted_entries(&ariac.join("faults")) {
-        let Some(flags) = injected(&scenario) else {
-            continue;
-        };
+    for scenario in &scenarios {
         let name = scenario.file_name().unwrap().to_string_lossy().into_owned();
+        let flags = injected(scenario)
+            .unwrap_or_else(|e| panic!("{name}: the C++ agent cannot play it: {e}"));
         let out = Command::new(&agent)
             .arg(&rules)
             .arg("--json")
@@ -127,16 +155,24 @@ fn the_cpp_agent_recovers_as_btc_run_replan_does() {
         );
         let cpp = json_of(&out);
         let ours = outcome(&cpp["report"], cpp_started(&cpp), strings(&cpp["kb"]));
-        let (cli, started) = cli_run(&rules, &ariac, &scenario);
-        let theirs = outcome(&cli, started, engine_kb(&rules, &scenario));
+        let (cli, started) = cli_run(&rules, &ariac, scenario);
+        let (kb, plans) = engine_kb(&rules, scenario);
+        let theirs = outcome(&cli, started, kb);
+        assert_eq!(
+            plans, theirs.plans,
+            "{name}: the reference loop does not decide as btc run --replan"
+        );
         assert_eq!(
             ours, theirs,
             "{name}: the C++ agent against btc run --replan"
         );
-        assert!(ours.goal_reached, "{name}");
         compared += 1;
     }
-    assert!(compared >= 2, "only {compared} scenarios compared");
+    assert!(
+        compared == scenarios.len() && compared >= 10,
+        "{compared} of {} scenarios compared",
+        scenarios.len()
+    );
 }
 
 /// The outcome a loop's report (btc-api's or `btc run --replan`'s JSON)
@@ -221,14 +257,14 @@ fn cli_run(rules: &Path, ariac: &Path, scenario: &Path) -> (serde_json::Value, V
 
 /// The final KB of the same loop with btc's engine as the executor (the
 /// engine `btc run --replan` runs; `btc run` does not print the final KB
-/// of a closed loop).
-fn engine_kb(rules: &Path, scenario: &Path) -> Vec<String> {
+/// of a closed loop), and its attempts' plans.
+fn engine_kb(rules: &Path, scenario: &Path) -> (Vec<String>, Vec<Vec<String>>) {
     let project = btc_api::Project::open(rules).unwrap();
     let mut agent = btc_api::Agent::new(project, None);
     let mut engine = engine::ReportingEngine::new(btc_api::Faults::open(scenario).unwrap());
     let report = agent
         .run_with(&btc_api::AgentOptions::default(), &mut engine)
         .unwrap();
-    assert!(report.goal_reached);
-    engine.kb
+    let plans = report.attempts.iter().map(|a| a.plan.clone()).collect();
+    (engine.kb, plans)
 }

@@ -10,15 +10,26 @@
 // simulation in this file; with ROS 2 it would be rclcpp_action.
 //
 //   ariac_agent RULES [--problem PROBLEM] [--work-ticks N] [--json]
-//               [--fail ACTION:N --kind KIND [--robot R] [--part P]
-//                [--retract FACT]... [--add FACT]... [--reason TEXT]]
+//               [(--fail ACTION:N | --fail-step N | --at-tick N) --kind KIND
+//                [--robot R] [--part P] [--retract FACT]... [--add FACT]...
+//                [--duration TICKS] [--goal GOAL] [--conditions running|failure]
+//                [--reason TEXT]]
 //
-// `--fail MoveTo:2 --kind faulty_gripper ...` makes the server abort the
-// second MoveTo goal; the node then reports that fault to btc
-// (`kb.reportFault`), which applies its `--retract`/`--add` facts and
-// replans. Prints each attempt's steps and the report; `--json` prints
-// {"report": btc's report, "attempts": [{"steps": [...], "faults": [...]}],
-// "kb": final facts}.
+// One fault happens, and is reported to btc (`kb.reportFault`) where a real
+// agent would learn of it:
+//   --fail MoveTo:2    by the node of the second MoveTo goal;
+//   --fail-step 3      by the first action node that starts in plan step 3
+//                      or later;
+//   --at-tick 2        from outside the tree, before tick 2 of the loop (an
+//                      order arrives, a part is found missing, the sensors
+//                      go dark): `Agent::before_tick`.
+// What the fault then does to the robot is the server's: a faulty gripper
+// aborts the goal (the part is dropped), a malfunction stops the robot's
+// goals for `--duration` ticks, a person too close or a priority order
+// pauses them, a sensor blackout makes the KB's conditions return RUNNING
+// (or FAILURE) meanwhile. Prints each attempt's steps and the report;
+// `--json` prints {"report": btc's report, "attempts": [{"steps": [...],
+// "faults": [...]}], "kb": final facts}.
 #include <btc/agent.hpp>
 #include <btc/nodes.hpp>
 
@@ -31,8 +42,9 @@
 namespace
 {
 
-/// The stand-in for an action server: a goal takes `work_ticks` polls, and
-/// the `fail_at`-th goal of `fail_action` is aborted.
+/// The stand-in for an action server: a goal takes `work_ticks` polls; a
+/// robot's goals stop while it is down and wait while it is paused (until
+/// a tick of the loop's clock, `now`).
 class FakeActionServer
 {
 public:
@@ -45,20 +57,34 @@ public:
   };
 
   int work_ticks = 2;
-  std::string fail_action;
-  int fail_at = 0;
+  /// The loop's tick, set before each one.
+  long now = 0;
+  std::map<std::string, long> down_until;
+  std::map<std::string, long> paused_until;
 
-  int sendGoal(const std::string& action)
+  /// A goal for `robot`; -1 when the server rejects it (the robot is down).
+  int sendGoal(const std::string& robot, bool abort)
   {
-    const int n = ++sent_[action];
-    goals_.push_back(Goal{ work_ticks, action == fail_action && n == fail_at, State::Running });
+    if(isDown(robot))
+    {
+      return -1;
+    }
+    goals_.push_back(Goal{ robot, work_ticks, abort, State::Running });
     return static_cast<int>(goals_.size()) - 1;
   }
 
   State poll(int id)
   {
     Goal& g = goals_.at(static_cast<std::size_t>(id));
-    if(g.state == State::Running && --g.left <= 0)
+    if(g.state != State::Running)
+    {
+      return g.state;
+    }
+    if(isDown(g.robot))
+    {
+      g.state = State::Aborted;
+    }
+    else if(now >= until(paused_until, g.robot) && --g.left <= 0)
     {
       g.state = g.abort ? State::Aborted : State::Succeeded;
     }
@@ -71,37 +97,147 @@ public:
     ++canceled;
   }
 
+  bool isDown(const std::string& robot) const { return now < until(down_until, robot); }
+
   int canceled = 0;
 
 private:
   struct Goal
   {
+    std::string robot;
     int left;
     bool abort;
     State state;
   };
+
+  static long until(const std::map<std::string, long>& m, const std::string& robot)
+  {
+    const auto it = m.find(robot);
+    return it == m.end() ? 0 : it->second;
+  }
+
   std::vector<Goal> goals_;
-  std::map<std::string, int> sent_;
 };
 
-/// What the server's aborted result says, as a btc fault.
-std::optional<btc::ReportedFault> injected;
+/// The one fault of a run, when and where it happens, and what it does to
+/// the robot once it has.
+class Fault
+{
+public:
+  enum class Trigger
+  {
+    None,
+    Action,  ///< the `occurrence`-th start of `action`
+    Step,  ///< the first action start in plan step `step` or later
+    Tick,  ///< before tick `tick` of the loop
+  };
+
+  Trigger trigger = Trigger::None;
+  std::string action;
+  int occurrence = 1;
+  int step = 0;
+  long tick = 0;
+  btc::ReportedFault report;
+  btc::Kb::Blackout blackout = btc::Kb::Blackout::Running;
+
+  /// An action node of `step` starts: whether the fault happens now (once).
+  bool dueAtStart(const std::string& id, const btc::Step* in_step)
+  {
+    const int n = ++started_[id];
+    const bool due =
+        (trigger == Trigger::Action && id == action && n >= occurrence) ||
+        (trigger == Trigger::Step && in_step != nullptr && in_step->number >= step);
+    return fire(due);
+  }
+
+  /// Before a tick: whether the fault happens now (once).
+  bool dueBeforeTick(long now) { return fire(trigger == Trigger::Tick && now >= tick); }
+
+  /// What the fault does besides its report: the server's robot stops or
+  /// waits, the sensors go dark.
+  void happen(FakeActionServer& server, long now)
+  {
+    const long end = now + report.duration.value_or(0);
+    const std::string robot = report.robot.value_or("");
+    if(report.kind == "robot_malfunction")
+    {
+      server.down_until[robot] = end;
+    }
+    else if(report.kind == "human_too_close" || report.kind == "high_priority_order")
+    {
+      server.paused_until[robot] = end;
+    }
+    else if(report.kind == "sensor_blackout")
+    {
+      dark_until_ = end;
+    }
+  }
+
+  /// The sensors as they are at tick `now`.
+  void sense(btc::Kb& kb, long now) const
+  {
+    kb.setBlackout(now < dark_until_ ? blackout : btc::Kb::Blackout::None);
+  }
+
+private:
+  bool fire(bool due)
+  {
+    if(fired_ || !due)
+    {
+      return false;
+    }
+    fired_ = true;
+    return true;
+  }
+
+  bool fired_ = false;
+  long dark_until_ = 0;
+  std::map<std::string, int> started_;
+};
 
 /// A robot action as a ROS 2 action client would run it: goal on start,
-/// poll while RUNNING, cancel when halted, a fault report when the server
-/// aborts.
+/// poll while RUNNING, cancel when halted, a fault report when it meets
+/// one (a faulty gripper's when the server aborts the goal).
 class ActionClient : public btc::Action
 {
 public:
   ActionClient(const std::string& name, const BT::NodeConfig& config, btc::Kb& kb,
-               FakeActionServer& server)
-    : btc::Action(name, config, kb), server_(server)
+               FakeActionServer& server, Fault& fault)
+    : btc::Action(name, config, kb), server_(server), fault_(fault)
   {}
 
 private:
   BT::NodeStatus onStart() override
   {
-    goal_ = server_.sendGoal(registrationName());
+    dropping_ = false;
+    if(fault_.dueAtStart(registrationName(), step()))
+    {
+      if(fault_.report.kind == "faulty_gripper")
+      {
+        dropping_ = true;
+      }
+      else
+      {
+        kb().reportFault(fault_.report);
+        fault_.happen(server_, server_.now);
+      }
+    }
+    if(!preconditionHolds())
+    {
+      if(dropping_)
+      {
+        // The gripper failed as the action began: still the fault's.
+        kb().reportFault(fault_.report);
+      }
+      return BT::NodeStatus::FAILURE;
+    }
+    const auto robot = input<std::string>("robot");
+    goal_ = server_.sendGoal(robot, dropping_);
+    if(goal_ < 0)
+    {
+      kb().noteFailure(name(), "the server rejected the goal: `" + robot + "` is down");
+      return BT::NodeStatus::FAILURE;
+    }
     return BT::NodeStatus::RUNNING;
   }
 
@@ -114,9 +250,11 @@ private:
       case FakeActionServer::State::Succeeded:
         return BT::NodeStatus::SUCCESS;
       default:
-        if(injected)
+        kb().noteFailure(name(), dropping_ ? "the gripper dropped the part"
+                                           : "the server aborted the goal");
+        if(dropping_)
         {
-          kb().reportFault(*injected);
+          kb().reportFault(fault_.report);
         }
         return BT::NodeStatus::FAILURE;
     }
@@ -125,7 +263,9 @@ private:
   void onHalted() override { server_.cancel(goal_); }
 
   FakeActionServer& server_;
+  Fault& fault_;
   int goal_ = -1;
+  bool dropping_ = false;
 };
 
 btc::PortSpec port(const char* name)
@@ -136,8 +276,10 @@ btc::PortSpec port(const char* name)
 int usage()
 {
   std::cerr << "usage: ariac_agent RULES [--problem PROBLEM] [--work-ticks N] [--json]\n"
-               "         [--fail ACTION:N --kind KIND [--robot R] [--part P]\n"
-               "          [--retract FACT]... [--add FACT]... [--reason TEXT]]\n";
+               "         [(--fail ACTION:N | --fail-step N | --at-tick N) --kind KIND\n"
+               "          [--robot R] [--part P] [--retract FACT]... [--add FACT]...\n"
+               "          [--duration TICKS] [--goal GOAL] [--conditions running|failure]\n"
+               "          [--reason TEXT]]\n";
   return 2;
 }
 
@@ -153,7 +295,8 @@ int main(int argc, char** argv)
   std::optional<std::string> problem;
   FakeActionServer server;
   bool as_json = false;
-  btc::ReportedFault fault;
+  Fault fault;
+  btc::ReportedFault& report = fault.report;
   for(std::size_t i = 1; i < args.size(); ++i)
   {
     const std::string& a = args[i];
@@ -178,41 +321,65 @@ int main(int argc, char** argv)
     {
       const std::string v = args[++i];
       const auto colon = v.find(':');
-      server.fail_action = v.substr(0, colon);
-      server.fail_at = colon == std::string::npos ? 1 : std::stoi(v.substr(colon + 1));
+      fault.trigger = Fault::Trigger::Action;
+      fault.action = v.substr(0, colon);
+      fault.occurrence = colon == std::string::npos ? 1 : std::stoi(v.substr(colon + 1));
+    }
+    else if(a == "--fail-step")
+    {
+      fault.trigger = Fault::Trigger::Step;
+      fault.step = std::stoi(args[++i]);
+    }
+    else if(a == "--at-tick")
+    {
+      fault.trigger = Fault::Trigger::Tick;
+      fault.tick = std::stol(args[++i]);
     }
     else if(a == "--kind")
     {
-      fault.kind = args[++i];
+      report.kind = args[++i];
     }
     else if(a == "--robot")
     {
-      fault.robot = args[++i];
+      report.robot = args[++i];
     }
     else if(a == "--part")
     {
-      fault.part = args[++i];
+      report.part = args[++i];
     }
     else if(a == "--retract")
     {
-      fault.retract.push_back(args[++i]);
+      report.retract.push_back(args[++i]);
     }
     else if(a == "--add")
     {
-      fault.add.push_back(args[++i]);
+      report.add.push_back(args[++i]);
+    }
+    else if(a == "--duration")
+    {
+      report.duration = std::stol(args[++i]);
+    }
+    else if(a == "--goal")
+    {
+      report.goal = args[++i];
+    }
+    else if(a == "--conditions" && (args[i + 1] == "running" || args[i + 1] == "failure"))
+    {
+      fault.blackout =
+          args[++i] == "running" ? btc::Kb::Blackout::Running : btc::Kb::Blackout::Failure;
     }
     else if(a == "--reason")
     {
-      fault.reason = args[++i];
+      report.reason = args[++i];
     }
     else
     {
       return usage();
     }
   }
-  if(!server.fail_action.empty())
+  if(fault.trigger != Fault::Trigger::None && report.kind.empty())
   {
-    injected = fault;
+    return usage();
   }
 
   try
@@ -228,8 +395,19 @@ int main(int argc, char** argv)
     for(const auto& [id, ports] : actions)
     {
       factory.registerNodeType<ActionClient>(id, btc::inputPorts(ports), std::ref(agent.kb()),
-                                             std::ref(server));
+                                             std::ref(server), std::ref(fault));
     }
+    // News from outside the tree: the clock the server runs on, a fault
+    // due at this tick, the sensors.
+    agent.before_tick = [&](long tick, btc::Kb& kb) {
+      server.now = tick;
+      if(fault.dueBeforeTick(tick))
+      {
+        kb.reportFault(report);
+        fault.happen(server, tick);
+      }
+      fault.sense(kb, tick);
+    };
 
     nlohmann::json attempts = nlohmann::json::array();
     agent.on_attempt = [&](const btc::AttemptInput& in, const btc::AttemptResult& out) {
@@ -259,10 +437,10 @@ int main(int argc, char** argv)
       }
     };
 
-    const btc::AgentReport report = agent.run();
+    const btc::AgentReport result = agent.run();
     if(as_json)
     {
-      nlohmann::json out{ { "report", report.json },
+      nlohmann::json out{ { "report", result.json },
                           { "attempts", attempts },
                           { "kb", agent.kb().snapshot() },
                           { "canceled_goals", server.canceled } };
@@ -270,11 +448,11 @@ int main(int argc, char** argv)
     }
     else
     {
-      std::cout << "goal " << (report.goal_reached ? "reached" : "not reached") << ": "
-                << report.goal << " (" << report.replans << " replans, " << server.canceled
+      std::cout << "goal " << (result.goal_reached ? "reached" : "not reached") << ": "
+                << result.goal << " (" << result.replans << " replans, " << server.canceled
                 << " goals canceled)\n";
     }
-    return report.goal_reached ? 0 : 1;
+    return result.goal_reached ? 0 : 1;
   }
   catch(const btc::Error& e)
   {

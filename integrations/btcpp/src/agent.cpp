@@ -37,6 +37,13 @@ public:
     r.node_id = node.registrationName();
     r.node_name = node.name();
     r.step = kb_.currentStep();
+    // A leaf outside every step (a monitor beside the plan) fails the step
+    // that was running, as btc's engine records it.
+    for(int s = 1; r.step == 0 && s <= kb_.stepCount(); ++s)
+    {
+      const Step* st = kb_.step(s);
+      r.step = st != nullptr && st->started && !st->finished ? s : 0;
+    }
     r.reason = kb_.lastFailureWhy();
     r.tick = tick_;
     last = std::move(r);
@@ -237,17 +244,30 @@ AttemptResult Agent::execute(const AttemptInput& attempt, long max_ticks)
   {
     auto tree = factory_.createTreeFromText(attempt.tree_xml);
     FailureObserver observer(tree.rootNode(), kb_, tick);
-    while(tick < max_ticks)
-    {
-      ++tick;
-      status = tree.tickExactlyOnce();
-      // Faults reported during this tick happened at it.
+    // Faults reported before or during a tick happened at it.
+    const auto collect = [&] {
       for(auto& f : kb_.takeFaults())
       {
         f.tick = tick;
         result.faults.push_back(std::move(f));
       }
-      if(status != BT::NodeStatus::RUNNING)
+    };
+    while(tick < max_ticks)
+    {
+      ++tick;
+      if(before_tick)
+      {
+        before_tick(attempt.tick + tick, kb_);
+        collect();
+        if(orderFirst(result.faults))
+        {
+          status = BT::NodeStatus::RUNNING;
+          break;
+        }
+      }
+      status = tree.tickExactlyOnce();
+      collect();
+      if(status != BT::NodeStatus::RUNNING || orderFirst(result.faults))
       {
         break;
       }
@@ -297,6 +317,30 @@ AttemptResult Agent::execute(const AttemptInput& attempt, long max_ticks)
     on_attempt(attempt, result);
   }
   return result;
+}
+
+bool Agent::orderFirst(const std::vector<ReportedFault>& faults)
+{
+  for(const auto& f : faults)
+  {
+    if(f.kind != "high_priority_order" || !f.goal)
+    {
+      continue;
+    }
+    try
+    {
+      if(!kb_.holds(*f.goal))
+      {
+        return true;
+      }
+    }
+    catch(const KbError&)
+    {
+      // A goal that does not fit the problem: the loop refuses the report
+      // when the attempt ends, with its diagnostic.
+    }
+  }
+  return false;
 }
 
 AgentReport Agent::run(const AgentOptions& options)

@@ -35,6 +35,7 @@ struct Kb::Impl
   std::string last_failure;
   std::string last_failure_why;
   std::vector<ReportedFault> faults;
+  Kb::Blackout blackout = Kb::Blackout::None;
 
   std::vector<Id>& scratch() const
   {
@@ -339,9 +340,79 @@ void Kb::resetSteps()
   p_->last_failure_why.clear();
 }
 
+namespace
+{
+
+/// Whether a shown atom, `(p a b)`, has `object` among its arguments.
+bool mentions(const std::string& atom, const std::string& object)
+{
+  std::size_t at = atom.find(' ');
+  while(at != std::string::npos)
+  {
+    const std::size_t from = at + 1;
+    at = atom.find(' ', from);
+    const std::size_t end = at == std::string::npos ? atom.size() - 1 : at;
+    if(atom.compare(from, end - from, object) == 0 && end - from == object.size())
+    {
+      return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
 void Kb::reportFault(ReportedFault fault)
 {
+  // The changes apply now, as btc's engine applies a scenario's fault when
+  // it happens (`FaultSpec::changes`): the rest of the tick and the ticks
+  // after it see the world the fault left.
+  std::vector<std::string> retract = fault.retract;
+  if(retract.empty() && fault.part && (fault.kind == "faulty_part" || fault.kind == "insufficient_parts"))
+  {
+    for(const auto& k : p_->state.facts)
+    {
+      std::string atom = p_->world.showAtom(k);
+      if(mentions(atom, *fault.part))
+      {
+        retract.push_back(std::move(atom));
+      }
+    }
+  }
+  if(!retract.empty() || !fault.add.empty())
+  {
+    std::string text = "(and";
+    for(const auto& r : retract)
+    {
+      text += " (not " + r + ")";
+    }
+    for(const auto& a : fault.add)
+    {
+      text += " " + a;
+    }
+    text += ")";
+    try
+    {
+      apply(text);
+    }
+    catch(const KbError&)
+    {
+      // A fact that does not fit the problem: the loop refuses the report
+      // when the attempt ends, with a diagnostic naming the fault and the
+      // fact, which is the error the caller gets.
+    }
+  }
   p_->faults.push_back(std::move(fault));
+}
+
+void Kb::setBlackout(Blackout b)
+{
+  p_->blackout = b;
+}
+
+Kb::Blackout Kb::blackout() const
+{
+  return p_->blackout;
 }
 
 std::vector<ReportedFault> Kb::takeFaults()

@@ -226,9 +226,38 @@ BT::PortsList KbHolds::providedPorts()
   return { BT::InputPort<std::string>("formula", "a ground PDDL condition") };
 }
 
+namespace
+{
+
+/// What a condition returns while the sensors are dark, as btc's engine
+/// has it (a FAILURE says why); none when they are not.
+std::optional<NodeStatus> inBlackout(Kb& kb, const std::string& node)
+{
+  switch(kb.blackout())
+  {
+    case Kb::Blackout::Running:
+      return NodeStatus::RUNNING;
+    case Kb::Blackout::Failure:
+      kb.noteFailure(node, "sensor blackout: the condition cannot be read");
+      return NodeStatus::FAILURE;
+    default:
+      return std::nullopt;
+  }
+}
+
+}  // namespace
+
 NodeStatus KbHolds::tick()
 {
-  if(!formula_ || kb_.holds(*formula_))
+  if(!formula_)
+  {
+    return NodeStatus::SUCCESS;
+  }
+  if(const auto dark = inBlackout(kb_, name()))
+  {
+    return *dark;
+  }
+  if(kb_.holds(*formula_))
   {
     return NodeStatus::SUCCESS;
   }
@@ -320,6 +349,10 @@ NodeStatus Condition::tick()
   {
     return NodeStatus::SUCCESS;
   }
+  if(const auto dark = inBlackout(kb_, name()))
+  {
+    return *dark;
+  }
   const std::string text = groundFormula();
   FormulaId f = 0;
   try
@@ -350,7 +383,7 @@ Step* Action::step() const
   return kb_.step(kb_.currentStep());
 }
 
-NodeStatus Action::onStart()
+bool Action::preconditionHolds()
 {
   if(const Step* st = step())
   {
@@ -358,8 +391,17 @@ NodeStatus Action::onStart()
     {
       kb_.noteFailure(name(),
                       "its step's precondition does not hold: " + kb_.whyNot(*pre));
-      return NodeStatus::FAILURE;
+      return false;
     }
+  }
+  return true;
+}
+
+NodeStatus Action::onStart()
+{
+  if(!preconditionHolds())
+  {
+    return NodeStatus::FAILURE;
   }
   if(kb_.ticks_per_action <= 0)
   {

@@ -11,7 +11,10 @@
 //   btc::AgentReport report = agent.run();
 //
 // A node reports a fault with `kb.reportFault({...})` and returns FAILURE
-// (see `btc::ReportedFault`).
+// (see `btc::ReportedFault`); what comes from outside the tree is reported
+// before a tick (`Agent::before_tick`). A reported `high_priority_order`
+// whose goal does not hold halts the tree at once: the order comes first,
+// and btc plans it.
 #pragma once
 
 #include <behaviortree_cpp/bt_factory.h>
@@ -114,16 +117,29 @@ public:
 
   /// One attempt: builds `attempt`'s tree in the factory (registering btc's
   /// KB nodes, formula conditions and simulated actions the factory lacks),
-  /// sets the KB to its state and goal, ticks it to the end and collects
-  /// the record, the reported faults and the step events. `run` calls it
+  /// sets the KB to its state and goal, ticks it to the end (calling
+  /// `before_tick` before every tick) and collects the record, the reported
+  /// faults and the step events; a reported order whose goal does not hold
+  /// ends it RUNNING, the tree halted. `run` calls it
   /// for every attempt; call it yourself to execute a tree btc compiled.
   AttemptResult execute(const AttemptInput& attempt, long max_ticks);
 
   /// Called after each attempt, with what it came to (for logging).
   std::function<void(const AttemptInput&, const AttemptResult&)> on_attempt;
 
+  /// Called before each tick with the tick about to run, counted over the
+  /// whole loop (`AttemptInput::tick` plus the attempt's ticks, 1-based),
+  /// and the KB: where news from outside the tree comes in. Perception
+  /// updating facts, or a fault no node meets: an order arrives or a part
+  /// is found missing (`kb.reportFault({...})`, a fault of that tick), the
+  /// sensors go dark (`kb.setBlackout(...)`, and back at the end).
+  std::function<void(long tick, Kb& kb)> before_tick;
+
 private:
   void registerMissing(const std::vector<NodeInfo>& nodes);
+  /// Whether a reported order's goal does not hold: the order preempts
+  /// the tree, as in btc's engine.
+  bool orderFirst(const std::vector<ReportedFault>& faults);
 
   BT::BehaviorTreeFactory& factory_;
   Kb kb_;

@@ -66,9 +66,9 @@ struct StepEvent
 };
 
 /// A fault a node reports (`Kb::reportFault`): one of ARIAC 2023's fault
-/// kinds, what it names, and how it changes the KB. The closed loop
-/// (`btc::Agent`) applies `retract` and `add` to the state it replans
-/// from and adjusts the goal as `btc run --replan` does: a spare part for
+/// kinds, what it names, and how it changes the KB (at once: see
+/// `Kb::reportFault`). The closed loop (`btc::Agent`) replans from the
+/// state the fault left and adjusts the goal as `btc run --replan` does: a spare part for
 /// a discarded one (`faulty_part`, `flipped_part` with a `part`), a
 /// priority order's `goal` first (`high_priority_order`).
 struct ReportedFault
@@ -183,10 +183,31 @@ public:
   /// its own.
   void resetSteps();
 
-  /// Reports a fault: call it from a node that then returns FAILURE.
+  /// Reports a fault: from a node that then returns FAILURE, or from
+  /// outside the tree between ticks (`Agent::before_tick`: an order
+  /// arrives, a part is found missing). Its changes apply now, as btc's
+  /// engine applies a scenario's fault: the `retract` facts become false
+  /// and the `add` facts true; a `faulty_part` or `insufficient_parts`
+  /// without `retract` takes every fact that names its `part` (it is
+  /// gone). A fact that does not fit the problem changes nothing here; the
+  /// loop refuses the report when the attempt ends.
   void reportFault(ReportedFault fault);
   /// The faults reported since the last call, which forgets them.
   std::vector<ReportedFault> takeFaults();
+
+  /// What the KB's conditions (conditions defined by a formula, `KbHolds`)
+  /// return while the sensors they stand in for send nothing, as in a
+  /// sensor blackout of btc's engine: RUNNING, or FAILURE. `None`, the
+  /// default: they evaluate their formula. Whoever knows of the blackout
+  /// (perception, `Agent::before_tick`) sets it and sets it back.
+  enum class Blackout
+  {
+    None,
+    Running,
+    Failure
+  };
+  void setBlackout(Blackout b);
+  Blackout blackout() const;
 
   /// How long simulated action leaves run: RUNNING for this many ticks,
   /// then SUCCESS (0: they succeed at once). `btc run --ticks-per-action`.

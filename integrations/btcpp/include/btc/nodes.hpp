@@ -99,7 +99,8 @@ private:
   int number_ = 0;
 };
 
-/// SUCCESS when a ground formula holds on the KB, else FAILURE.
+/// SUCCESS when a ground formula holds on the KB, else FAILURE (in a
+/// sensor blackout, what `Kb::blackout()` says).
 class KbHolds : public BT::ConditionNode
 {
 public:
@@ -141,8 +142,8 @@ private:
 };
 
 /// A condition leaf. With a formula, SUCCESS when the formula, with the
-/// ports' values for its variables, holds on the KB at this tick; without
-/// one, SUCCESS. Derive from it (or from the generated base) and override
+/// ports' values for its variables, holds on the KB at this tick (in a
+/// sensor blackout, what `Kb::blackout()` says); without one, SUCCESS. Derive from it (or from the generated base) and override
 /// `tick()` to read a real sensor instead.
 class Condition : public BT::ConditionNode
 {
@@ -182,6 +183,11 @@ protected:
   Kb& kb() const { return kb_; }
   /// The plan step this action runs in, or null outside every step.
   Step* step() const;
+  /// Whether the step's precondition holds (true outside every step);
+  /// when it does not, the KB notes why, in the words of btc's engine, for
+  /// the fault record. The default `onStart()` checks it; an `onStart()`
+  /// of yours that sends a goal checks it first, as btc's engine does.
+  bool preconditionHolds();
   /// An input port's value (see `btc::input`).
   template <class T>
   T input(const std::string& port) const
