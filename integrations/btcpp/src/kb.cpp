@@ -368,7 +368,8 @@ void Kb::reportFault(ReportedFault fault)
   // it happens (`FaultSpec::changes`): the rest of the tick and the ticks
   // after it see the world the fault left.
   std::vector<std::string> retract = fault.retract;
-  if(retract.empty() && fault.part && (fault.kind == "faulty_part" || fault.kind == "insufficient_parts"))
+  const bool gone = fault.kind == "faulty_part" || fault.kind == "insufficient_parts";
+  if(retract.empty() && fault.part && gone)
   {
     for(const auto& k : p_->state.facts)
     {

@@ -68,9 +68,9 @@ struct StepEvent
 /// A fault a node reports (`Kb::reportFault`): one of ARIAC 2023's fault
 /// kinds, what it names, and how it changes the KB (at once: see
 /// `Kb::reportFault`). The closed loop (`btc::Agent`) replans from the
-/// state the fault left and adjusts the goal as `btc run --replan` does: a spare part for
-/// a discarded one (`faulty_part`, `flipped_part` with a `part`), a
-/// priority order's `goal` first (`high_priority_order`).
+/// state the fault left and adjusts the goal as `btc run --replan` does: a
+/// spare part for a discarded one (`faulty_part`, `flipped_part` with a
+/// `part`), a priority order's `goal` first (`high_priority_order`).
 struct ReportedFault
 {
   /// faulty_part, faulty_gripper, robot_malfunction, flipped_part,

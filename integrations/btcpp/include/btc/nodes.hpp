@@ -143,8 +143,9 @@ private:
 
 /// A condition leaf. With a formula, SUCCESS when the formula, with the
 /// ports' values for its variables, holds on the KB at this tick (in a
-/// sensor blackout, what `Kb::blackout()` says); without one, SUCCESS. Derive from it (or from the generated base) and override
-/// `tick()` to read a real sensor instead.
+/// sensor blackout, what `Kb::blackout()` says); without one, SUCCESS.
+/// Derive from it (or from the generated base) and override `tick()` to
+/// read a real sensor instead.
 class Condition : public BT::ConditionNode
 {
 public:
