@@ -32,6 +32,7 @@ Importing this file has no side effects.
 """
 
 import argparse
+import contextvars
 import json
 import sys
 import time
@@ -487,13 +488,58 @@ class Plan:
 # Behaviours that read and write the knowledge base
 
 
+class _SharedKb:
+    """The one blackboard client for `/btc/kb` that the behaviours of a
+    tree `build_tree` builds share. Registering a py_trees client costs
+    more than making the behaviour (a uuid, the blackboard's metadata),
+    and an agent builds a tree per plan. It goes when the tree is shut
+    down or its last behaviour is collected."""
+
+    def __init__(self):
+        self.client = py_trees.blackboard.Client(name="btc tree")
+        self.client.register_key(key=KB_KEY, access=WRITE)
+        self.release = weakref.finalize(self, self.client.unregister, False)
+
+
+class _Sharing:
+    """While `build_tree` builds (in this thread or task): the tree's shared
+    client, made when the first behaviour asks for it."""
+
+    current = contextvars.ContextVar("btc_runtime_sharing", default=None)
+
+    def __init__(self):
+        self.shared = None
+
+    def __enter__(self):
+        self.token = _Sharing.current.set(self)
+        return self
+
+    def __exit__(self, *exc):
+        _Sharing.current.reset(self.token)
+
+    def kb(self):
+        if self.shared is None:
+            self.shared = _SharedKb()
+        return self.shared
+
+
 class _KbClient:
     """A behaviour's blackboard client for `/btc/kb`, released when the
     tree is shut down or the behaviour is collected: py_trees keeps every
     registered client until it is unregistered, so a long-running agent
-    that builds a tree per plan would otherwise collect them."""
+    that builds a tree per plan would otherwise collect them. Behaviours
+    `build_tree` builds share one client (`_SharedKb`); one made on its own
+    has its own."""
 
     def _attach_kb(self, name, access):
+        sharing = _Sharing.current.get()
+        if sharing is not None:
+            shared = sharing.kb()
+            # Held by each behaviour: the client lives as long as the tree.
+            self._shared_kb = shared
+            self._release_kb = shared.release
+            self.blackboards.append(shared.client)
+            return shared.client
         client = self.attach_blackboard_client(name=name)
         client.register_key(key=KB_KEY, access=access)
         self._release_kb = weakref.finalize(self, client.unregister, False)
@@ -1118,7 +1164,8 @@ class _Builder:
 def build_tree(spec, trees, classes, plan):
     """The py_trees behaviours for a generated module's `ROOT` (`trees`:
     its `TREES`, `classes`: its `(node id, leaf class)` pairs by index)."""
-    return _Builder(plan, trees, classes).build(spec, {}, 0, None)
+    with _Sharing():
+        return _Builder(plan, trees, classes).build(spec, {}, 0, None)
 
 
 # ---------------------------------------------------------------------------

@@ -230,6 +230,35 @@ class BlackboardClientsTest(unittest.TestCase):
         py_trees.trees.BehaviourTree(root).shutdown()
         self.assertEqual(self.clients(), before)
 
+    def built(self):
+        """A tree as `build_tree` builds it: a step over a retry of a
+        condition and an action, under a timeout."""
+        shapes = (("a", None, None, None, None, None),)
+        plan = rt.Plan(shapes, ((0, ()),))
+        leaf = ("L", 0, None, ())
+        cond = ("L", 1, None, ())
+        root = ("S", 0, ("D", "timeout", 1000, None, ("Q", None, (cond, leaf))))
+        classes = (("act", rt.Action), ("ok", rt.Condition))
+        return rt.build_tree(root, (), classes, plan), rt.KnowledgeBase(world(), plan)
+
+    def test_a_built_tree_shares_one_client(self):
+        import gc
+
+        before = self.clients()
+        root, kb = self.built()
+        self.assertEqual(self.clients(), before + 1)
+        result = rt.run(root, kb, 10)
+        self.assertEqual(result.status, Status.SUCCESS)
+        py_trees.trees.BehaviourTree(root).shutdown()
+        self.assertEqual(self.clients(), before)
+        for _ in range(50):
+            root, kb = self.built()
+            rt.run(root, kb, 10)
+        self.assertLessEqual(self.clients(), before + 50)
+        del root, kb
+        gc.collect()
+        self.assertEqual(self.clients(), before)
+
     def test_a_dropped_tree_releases_its_clients(self):
         import gc
 
