@@ -642,6 +642,7 @@ fn hostile_names_stay_strings() {
                         "import py_trees",
                         "import user_nodes",
                         "import argparse",
+                        "import contextvars",
                         "import json",
                         "import time",
                         "import weakref",
