@@ -26,6 +26,7 @@ pub mod state;
 pub mod types;
 pub mod validate;
 pub mod world;
+pub mod written_problem;
 
 pub use ast::{Domain, Problem};
 pub use check::{check_domain, check_problem, DomainIndex, ProblemIndex};

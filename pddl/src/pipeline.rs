@@ -67,7 +67,20 @@ pub fn problem_unit_from(
     domain: Option<&Domain>,
     dix: &DomainIndex,
 ) -> ProblemUnit {
-    let (problem, mut diagnostics) = crate::parse_problem(text, file);
+    let (problem, diagnostics) = crate::parse_problem(text, file);
+    problem_unit_of(problem, diagnostics, file, domain, dix)
+}
+
+/// A problem already made (parsed, or given as a value: see
+/// [`crate::written_problem`]) checked against its domain; `diagnostics`
+/// are what making it raised.
+pub fn problem_unit_of(
+    problem: Option<Problem>,
+    mut diagnostics: Vec<Diagnostic>,
+    file: FileId,
+    domain: Option<&Domain>,
+    dix: &DomainIndex,
+) -> ProblemUnit {
     let index = match (&problem, domain) {
         (Some(p), Some(d)) => {
             let (index, diags) = crate::check_problem(p, d, dix);

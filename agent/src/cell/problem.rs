@@ -8,9 +8,9 @@
 use super::template::{GroundAtom, Var};
 use super::Cell;
 use crate::trial::{PartKind, PartType, Trial};
+use btc_pddl::written_problem::{ProblemWriter, WrittenProblem};
 use serde::Serialize;
 use std::collections::BTreeMap;
-use std::fmt::Write;
 
 /// Where a part starts.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -45,8 +45,8 @@ pub struct TrialProblem {
     /// Objects by type, in print order.
     pub objects: Vec<(String, Vec<String>)>,
     pub init: Vec<GroundAtom>,
-    /// The printed problem.
-    pub text: String,
+    /// The problem as a value; the rules database compiles against it.
+    pub written: WrittenProblem,
 }
 
 impl TrialProblem {
@@ -221,39 +221,30 @@ impl TrialProblem {
         let mut seen = std::collections::HashSet::new();
         init.retain(|a| seen.insert(a.clone()));
 
-        let text = print(name, cell.domain_name(), &by_type, &init);
+        let written = write(name, cell.domain_name(), &by_type, &init);
         TrialProblem {
             parts,
             objects: by_type,
             init,
-            text,
+            written,
         }
     }
 }
 
-fn print(
+/// The problem as a value, with the text it reads as (what a diagnostic
+/// on it shows).
+fn write(
     name: &str,
     domain: &str,
     objects: &[(String, Vec<String>)],
     init: &[GroundAtom],
-) -> String {
-    let mut s = String::new();
-    let _ = writeln!(s, "; The trial's world, written by `btc trial`.");
-    let _ = writeln!(s, "(define (problem {name})");
-    let _ = writeln!(s, "  (:domain {domain})");
-    s.push_str("  (:objects");
+) -> WrittenProblem {
+    let mut w = ProblemWriter::new("The trial's world, written by `btc trial`.", name, domain);
     for (ty, names) in objects {
-        s.push_str("\n   ");
-        for n in names {
-            s.push(' ');
-            s.push_str(n);
-        }
-        let _ = write!(s, " - {ty}");
+        w.objects(ty, names);
     }
-    s.push_str(")\n  (:init");
     for a in init {
-        let _ = write!(s, "\n    {a}");
+        w.fact(&a.pred, &a.args);
     }
-    s.push_str(")\n  (:goal (and)))\n");
-    s
+    w.finish()
 }

@@ -78,10 +78,11 @@ impl<'c> Runner<'c> {
     ) -> Result<TrialReport, TrialError> {
         let t0 = Instant::now();
         let tp = TrialProblem::build(self.cell, trial, "trial");
-        self.db.set_file(PROBLEM_PATH, tp.text.clone());
+        self.db.set_problem(PROBLEM_PATH, tp.written.clone());
         let pid = db::file_id(&self.db, self.problem);
-        let pu = pipeline::problem_unit_from(
-            &tp.text,
+        let pu = pipeline::problem_unit_of(
+            Some(tp.written.problem(pid)),
+            Vec::new(),
             pid,
             self.cell.domain.domain.as_ref(),
             &self.cell.domain.index,

@@ -154,5 +154,67 @@ fn a_plan_value_compiles_as_its_text_does() {
     );
     // Text set again replaces the value.
     db.set_file(&path, "(fly floor_robot)\n".to_owned());
-    assert!(job.plan(&db).written(&db).is_none());
+    assert!(job.plan(&db).value(&db).is_none());
+}
+
+/// A problem given as a value compiles as its text does, and what is
+/// wrong with it is reported in its text, as for a file.
+#[test]
+fn a_problem_value_compiles_as_its_text_does() {
+    use btc_pddl::ast::{InitFact, TypeSpec};
+    let mut db = Database::new();
+    let job = example_job(&mut db, "examples/ariac");
+    let from_text = compile(&db, job).as_ref().expect("compiles").clone();
+    let (pf, df) = (
+        job_problem(&db, job).unwrap(),
+        job_domain(&db, job).unwrap(),
+    );
+    let read = checked_problem(&db, ProblemOf::new(&db, pf, df))
+        .problem
+        .clone()
+        .expect("parses");
+    let written = |extra: Option<(&str, &[&str])>| {
+        let mut w = btc_pddl::written_problem::ProblemWriter::new(
+            "a test's",
+            &read.name.name,
+            &read.domain.name,
+        );
+        for o in &read.objects {
+            let TypeSpec::Named { name } = &o.ty else {
+                panic!("the example's objects have one type each")
+            };
+            w.objects(&name.name, &[&o.name.name]);
+        }
+        for f in &read.init {
+            let InitFact::Atom { atom } = f else {
+                panic!("the example's facts are atoms")
+            };
+            let args: Vec<String> = atom.args.iter().map(|a| a.to_string()).collect();
+            w.fact(&atom.pred.name, &args);
+        }
+        if let Some((pred, args)) = extra {
+            w.fact(pred, args);
+        }
+        w.finish()
+    };
+    let (path, original) = (pf.path(&db).clone(), pf.text(&db).clone());
+    assert_eq!(db.set_problem(&path, written(None)), pf);
+    let from_value = compile(&db, job).as_ref().expect("compiles").clone();
+    let logic = |ir: &btc_ir::TreeIr| ir.steps.iter().map(|s| s.logic.clone()).collect::<Vec<_>>();
+    assert_eq!(logic(&from_text), logic(&from_value));
+    assert_eq!(from_text.root, from_value.root);
+    // A fact about an object the problem does not have, reported where
+    // its text has it.
+    db.set_problem(&path, written(Some(("is_enabled", &["nobody"]))));
+    let errors = compile(&db, job).as_ref().expect_err("refused").clone();
+    let e = &errors[0];
+    let text = pf.text(&db);
+    assert_eq!(
+        &text[e.span.start as usize..e.span.end as usize],
+        "nobody",
+        "{e:?}"
+    );
+    // Text set again replaces the value.
+    db.set_file(&path, original);
+    assert!(pf.value(&db).is_none());
 }

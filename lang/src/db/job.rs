@@ -73,8 +73,8 @@ pub struct TypedPlan {
 pub fn typed_plan(db: &dyn Db, job: CompileJob) -> TypedPlan {
     let pf = job.plan(db);
     let file = file_id(db, pf);
-    let (plan, mut diagnostics) = match pf.written(db) {
-        Some(w) => {
+    let (plan, mut diagnostics) = match pf.value(db) {
+        Some(crate::db::FileValue::Plan(w)) => {
             let diags = if w.is_empty() {
                 vec![btc_pddl::plan::parse::no_steps(file)]
             } else {
@@ -82,7 +82,7 @@ pub fn typed_plan(db: &dyn Db, job: CompileJob) -> TypedPlan {
             };
             (w.plan(file), diags)
         }
-        None => btc_pddl::plan::parse_plan(pf.text(db), file),
+        _ => btc_pddl::plan::parse_plan(pf.text(db), file),
     };
     let mut steps = Vec::new();
     if let (Some(d), Some(p)) = (job_domain(db, job), job_problem(db, job)) {

@@ -52,10 +52,18 @@ pub struct SourceFile {
     pub text: String,
     #[returns(ref)]
     pub decode: Option<DecodeProblem>,
-    /// A plan given as a value ([`Database::set_plan`]): the compiler
-    /// takes it as it is, and `text` is only what it reads as.
+    /// A plan or problem given as a value ([`Database::set_plan`],
+    /// [`Database::set_problem`]).
     #[returns(ref)]
-    pub written: Option<Arc<btc_pddl::plan::WrittenPlan>>,
+    pub value: Option<FileValue>,
+}
+
+/// A file given as a value, not read: the compiler takes the value as it
+/// is, and the file's text is only what it reads as (for diagnostics).
+#[derive(Clone, Debug, PartialEq)]
+pub enum FileValue {
+    Plan(Arc<btc_pddl::plan::WrittenPlan>),
+    Problem(Arc<btc_pddl::written_problem::WrittenProblem>),
 }
 
 /// Every file the database knows, by path, and the files a loader was
@@ -159,8 +167,8 @@ impl Database {
             if f.decode(self) != &decode {
                 f.set_decode(self).to(decode);
             }
-            if f.written(self).is_some() {
-                f.set_written(self).to(None);
+            if f.value(self).is_some() {
+                f.set_value(self).to(None);
             }
             return f;
         }
@@ -180,7 +188,21 @@ impl Database {
         plan: btc_pddl::plan::WrittenPlan,
     ) -> SourceFile {
         let f = self.set_file(path, plan.text().to_owned());
-        f.set_written(self).to(Some(Arc::new(plan)));
+        f.set_value(self).to(Some(FileValue::Plan(Arc::new(plan))));
+        f
+    }
+
+    /// Adds or replaces a problem given as a value (a program's world, the
+    /// trial's cell): as [`Database::set_plan`], the file holds the text it
+    /// reads as and the compiler checks the value without parsing it.
+    pub fn set_problem(
+        &mut self,
+        path: &(impl AsFilePath + ?Sized),
+        problem: btc_pddl::written_problem::WrittenProblem,
+    ) -> SourceFile {
+        let f = self.set_file(path, problem.text().to_owned());
+        f.set_value(self)
+            .to(Some(FileValue::Problem(Arc::new(problem))));
         f
     }
 

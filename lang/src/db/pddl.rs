@@ -71,12 +71,17 @@ pub struct ProblemOf<'db> {
 #[salsa::tracked(returns(ref))]
 pub fn checked_problem<'db>(db: &'db dyn Db, pair: ProblemOf<'db>) -> CheckedProblem {
     let d = checked_domain(db, pair.domain(db));
-    let u = problem_unit_from(
-        pair.problem(db).text(db),
-        file_id(db, pair.problem(db)),
-        d.domain.as_ref(),
-        &d.index,
-    );
+    let (file, id) = (pair.problem(db), file_id(db, pair.problem(db)));
+    let u = match file.value(db) {
+        Some(FileValue::Problem(w)) => btc_pddl::pipeline::problem_unit_of(
+            Some(w.problem(id)),
+            Vec::new(),
+            id,
+            d.domain.as_ref(),
+            &d.index,
+        ),
+        _ => problem_unit_from(file.text(db), id, d.domain.as_ref(), &d.index),
+    };
     CheckedProblem {
         problem: u.problem,
         index: u.index,
