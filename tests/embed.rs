@@ -222,6 +222,7 @@ const REPORTED: &[&str] = &[
     "faulty_part",
     "flipped_part",
     "high_priority_order",
+    "priority_order",
     "human_too_close",
     "insufficient_parts",
     "robot_malfunction",
