@@ -38,8 +38,13 @@ fuzz_target!(|data: &[u8]| {
     let (rules, domain, problem, plan) = (get(0), get(1), get(2), get(3));
     unsafe {
         let mut err = null_mut();
-        let problem_ptr = if pieces.len() > 2 { problem.as_ptr() } else { null() };
-        let project = btc_project_from_texts(rules.as_ptr(), domain.as_ptr(), problem_ptr, &mut err);
+        let problem_ptr = if pieces.len() > 2 {
+            problem.as_ptr()
+        } else {
+            null()
+        };
+        let project =
+            btc_project_from_texts(rules.as_ptr(), domain.as_ptr(), problem_ptr, &mut err);
         btc_string_free(err);
         let parsed = btc_plan_parse(plan.as_ptr(), &mut err);
         btc_string_free(err);

@@ -36,14 +36,16 @@ fuzz_target!(|data: &[u8]| {
     let (trial, mut diags) = btc_agent::trial::read(&text, fid);
     if let Some(t) = trial {
         let tp = TrialProblem::build(cell, &t, "fuzz");
-        let pf = db.set_file("trial.problem.pddl", tp.text.clone());
+        let pf = db.set_problem("trial.problem.pddl", tp.written.clone());
         let pid = db::file_id(&db, pf);
+        // The problem's text reads back as the value the trial runs on.
         let pu = problem_unit_from(
-            &tp.text,
+            tp.written.text(),
             pid,
             cell.domain.domain.as_ref(),
             &cell.domain.index,
         );
+        assert_eq!(pu.problem, Some(tp.written.problem(pid)));
         diags.extend(pu.diagnostics);
     }
     if let Err(more) = CellSpec::parse(&text, fid) {
