@@ -8,7 +8,7 @@
 
 use btc_agent::{run_loop, LoopOptions};
 use btc_lang::db::{CompileJob, Database};
-use btc_runtime::Scenario;
+use btc_agent::faults::Scenario;
 use divan::Bencher;
 use std::path::PathBuf;
 

@@ -8,6 +8,7 @@
 
 pub mod cell;
 pub mod execution;
+pub mod faults;
 pub mod matrix;
 pub mod random;
 pub mod replan;

@@ -4,7 +4,8 @@
 
 use btc_agent::{run_loop, LoopOptions};
 use btc_lang::db::{CompileJob, Database};
-use btc_runtime::{Scenario, Status};
+use btc_agent::faults::Scenario;
+use btc_runtime::Status;
 use btc_testkit::repo as root;
 
 /// The ARIAC rules and `problem` in a database, with an empty plan file

@@ -1,7 +1,8 @@
 //! The btc runtime: a behavior-tree engine with BehaviorTree.CPP v4 tick
 //! semantics that runs btc's tree IR and BT.CPP XML against a simulated
 //! world (a PDDL knowledge base), with an optional queued robot controller
-//! and injected ARIAC faults. Nothing here prints; `btc run` does.
+//! and a hook for the caller's fault injector (the ARIAC faults are one,
+//! in `btc-agent`). Nothing here prints; `btc run` does.
 //!
 //! Loading: [`spec::TreeDoc`] from the IR ([`spec::TreeDoc::from_ir`]) or
 //! XML ([`xml::parse`]), or a tree file of either kind ([`load_tree`]);
@@ -13,7 +14,6 @@ pub mod btlog;
 pub mod controller;
 pub mod engine;
 pub mod error;
-pub mod faults;
 pub mod handler;
 pub mod include;
 pub mod kb;
@@ -23,9 +23,10 @@ pub mod spec;
 pub mod xml;
 
 pub use controller::{Command, Controller};
-pub use engine::{Engine, FaultRecord, Options, Status, Value};
+pub use engine::{
+    Engine, FaultOutcome, FaultRecord, Injection, Injector, Interference, Options, Status, Value,
+};
 pub use error::LoadError;
-pub use faults::{FaultKind, FaultOutcome, Scenario};
 pub use handler::{ActionCall, ActionHandler, HaltHandler};
 pub use kb::Kb;
 pub use spec::TreeDoc;

@@ -8,7 +8,7 @@ use super::{push_event, Attempt, LoopError, LoopSummary, Run};
 use crate::execution;
 use btc_pddl::logic::Formula;
 use btc_runtime::engine::{FaultRecord, Status};
-use btc_runtime::faults::FaultKind;
+use crate::faults::{FaultKind, FaultsOnEngine};
 use btc_runtime::observers::JsonlTrace;
 use btc_runtime::{Kb, TreeDoc};
 use std::time::Instant;

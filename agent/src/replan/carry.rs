@@ -7,14 +7,14 @@ use btc_pddl::diagnostic::codes;
 use btc_pddl::logic::{Formula, Name, Terms};
 use btc_pddl::state::{State, World};
 use btc_runtime::error::LoadError;
-use btc_runtime::faults::FaultRt;
+use crate::faults::Faults;
 use btc_runtime::Kb;
 
 /// What carries from one attempt to the next.
 #[derive(Default)]
 pub(super) struct Carry {
     pub state: Option<State>,
-    pub faults: Option<Vec<FaultRt>>,
+    pub faults: Option<Faults>,
     pub tick: u64,
     /// Goals faults added (high-priority orders).
     pub extra_goals: Vec<Formula>,

@@ -16,7 +16,7 @@ use btc_pddl::logic::{Formula, InitFact};
 use btc_pddl::state::Key;
 use btc_runtime::engine::{Engine, FaultRecord, Status};
 use btc_runtime::error::LoadError;
-use btc_runtime::faults::{FaultKind, FaultOutcome, FaultRt, FaultSpec, Trigger};
+use crate::faults::{FaultKind, FaultOutcome, FaultSpec, Trigger};
 use std::sync::Arc;
 use std::time::Instant;
 

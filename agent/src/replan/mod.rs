@@ -28,7 +28,7 @@ use btc_pddl::source::Span;
 use btc_pddl::state::World;
 use btc_runtime::engine::{Engine, FaultRecord, Options, Status};
 use btc_runtime::error::LoadError;
-use btc_runtime::faults::{FaultOutcome, Scenario};
+use crate::faults::{FaultOutcome, Scenario};
 use carry::Carry;
 use planning::Planned;
 use serde::Serialize;

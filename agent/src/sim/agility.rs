@@ -10,8 +10,7 @@ use super::world::PartId;
 use crate::cell::Var;
 use crate::trial::{Condition, Robot, Task as OrderTask};
 use btc_pddl::state::Key;
-use btc_runtime::faults::{FaultKind, FaultSpec};
-use btc_runtime::Scenario;
+use crate::faults::{FaultKind, FaultSpec, FaultsOnEngine, Scenario};
 
 impl Sim<'_, '_> {
     /// Challenges on the clock: effects that end, drops that come, time

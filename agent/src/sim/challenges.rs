@@ -11,7 +11,7 @@ use super::tasks::PartId;
 use crate::cell::spec::Time;
 use crate::cell::{Cell, Origin, PartInfo};
 use crate::trial::{Behavior, ChallengeKind, Condition, PartKind, Robot, Trial};
-use btc_runtime::faults::{Blackout, FaultKind, FaultSpec, Trigger};
+use crate::faults::{Blackout, FaultKind, FaultSpec, Trigger};
 
 /// ARIAC's faulty parts: the first part placed in each flagged quadrant of
 /// the order's kit is faulty.

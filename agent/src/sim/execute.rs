@@ -16,7 +16,8 @@ use crate::execution::{self, Planning, PlanningWorld};
 use btc_pddl::source::Span;
 use btc_pddl::state::Key;
 use btc_runtime::observers::JsonlTrace;
-use btc_runtime::{Engine, Kb, Options, Scenario, Status, TreeDoc};
+use crate::faults::{FaultsOnEngine, Scenario};
+use btc_runtime::{Engine, Kb, Options, Status, TreeDoc};
 
 impl<'w> Sim<'w, '_> {
     /// Plans, compiles and builds the tree of a task on agent `a`.

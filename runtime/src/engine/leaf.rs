@@ -38,10 +38,7 @@ impl<'w> Engine<'w> {
 
     #[inline(never)]
     pub(super) fn tick_kb_holds(&mut self, i: u32, f: FormulaId) -> Status {
-        if let Some(s) = self.blackout() {
-            if s == Status::Failure {
-                self.note_blackout(i);
-            }
+        if let Some(s) = self.inject_on_condition(i) {
             return s;
         }
         match self.kb.as_ref() {
@@ -75,10 +72,7 @@ impl<'w> Engine<'w> {
         let Some(formula) = self.conds[cu].formula else {
             return Status::Success;
         };
-        if let Some(s) = self.blackout() {
-            if s == Status::Failure {
-                self.note_blackout(i);
-            }
+        if let Some(s) = self.inject_on_condition(i) {
             return s;
         }
         if self.conds[cu].generation != self.bb_gen {
@@ -129,8 +123,8 @@ impl<'w> Engine<'w> {
         }
         let iu = i as usize;
         let running = self.status[iu] == Status::Running;
-        if self.faults_live {
-            if let Some(s) = self.faults_on_action(i, a, !running) {
+        if self.inject_live {
+            if let Some(s) = self.inject_on_action(i, a, !running) {
                 if s == Status::Failure {
                     self.state[iu] = NodeState::Fresh;
                 }
@@ -222,11 +216,4 @@ impl<'w> Engine<'w> {
         self.value(&p.src)
     }
 
-    /// Whether an action's ports name `object`.
-    pub(crate) fn action_mentions(&self, a: u32, object: &str) -> bool {
-        let (p, q) = self.actions[a as usize].ports;
-        self.ports[p as usize..q as usize]
-            .iter()
-            .any(|b| matches!(self.value(&b.src), Value::Text(t) if &**t == object))
-    }
 }

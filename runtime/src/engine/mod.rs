@@ -9,17 +9,18 @@
 //! arena; `control`, `decorator`, `leaf` and `step` are the tick semantics
 //! of each family of nodes; `record` is why nodes fail and the fault
 //! records; the tick's observers and hooks are `observe` (status changes
-//! and events go to the caller's observers), `faults` (injected faults: before a tick, when a step or an
-//! action starts, when a condition is read) and the controller (commands
-//! of action leaves).
+//! and events go to the caller's observers), `inject` (the caller's fault
+//! injector: before a tick, when a step starts, when an action leaf is
+//! ticked, when a condition is read) and the controller (commands of
+//! action leaves).
 
 mod build;
 mod control;
 mod decorator;
-mod faults;
 mod flow;
 mod guard;
 mod handled;
+mod inject;
 mod leaf;
 mod observe;
 pub(crate) mod port;
@@ -29,6 +30,7 @@ pub(crate) mod status;
 mod step;
 pub(crate) mod value;
 
+pub use inject::{ActionLeaf, FaultOutcome, Injection, Injector, Interference};
 pub use observe::{Observer, RunView, TickEvent};
 pub(crate) use port::{PortBind, Src};
 pub use record::FaultRecord;
@@ -37,7 +39,6 @@ pub use status::Status;
 pub use value::Value;
 
 use crate::controller::Controller;
-use crate::faults::FaultRt;
 use crate::handler::{ActionHandler, HaltHandler};
 use crate::kb::{ConditionId, EffectId, FormulaId, Kb};
 use serde::Serialize;
@@ -199,9 +200,11 @@ pub struct Engine<'w> {
     pub(crate) observers: Vec<Box<dyn Observer>>,
     pub(crate) last_failure: Option<(u32, Reason)>,
     pub records: Vec<FaultRecord>,
-    pub(crate) faults: Vec<FaultRt>,
-    /// Some fault is pending or in effect: leaves consult the faults.
-    pub(crate) faults_live: bool,
+    /// The caller's fault injector ([`Engine::inject`]).
+    pub(crate) injector: Option<Box<dyn Injector>>,
+    /// Some injected fault may happen or is in effect: leaves consult the
+    /// injector.
+    pub(crate) inject_live: bool,
     pub(crate) controller: Option<Controller>,
     pub(crate) handlers: Vec<ActionHandler<'w>>,
     pub(crate) halt_handlers: Vec<HaltHandler<'w>>,
@@ -270,8 +273,8 @@ impl<'w> Engine<'w> {
         if let Some(c) = self.controller.as_mut() {
             c.poll();
         }
-        if !self.faults.is_empty() {
-            self.faults_before_tick();
+        if self.injector.is_some() {
+            self.inject_before_tick();
         }
         if self.nodes.is_empty() {
             return Status::Success;

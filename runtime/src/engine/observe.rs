@@ -6,8 +6,7 @@
 
 use super::record::FaultRecord;
 use super::step::StepRt;
-use super::{Engine, NodeMeta, Status};
-use crate::faults::FaultRt;
+use super::{Engine, Injector, NodeMeta, Status};
 use std::any::Any;
 
 /// What happened during a tick.
@@ -46,7 +45,7 @@ pub enum TickEvent {
 pub struct RunView<'a> {
     pub meta: &'a [NodeMeta],
     steps: &'a [StepRt],
-    faults: &'a [FaultRt],
+    injector: Option<&'a dyn Injector>,
     records: &'a [FaultRecord],
 }
 
@@ -58,9 +57,7 @@ impl RunView<'_> {
 
     /// An injected fault's label and the name of its kind.
     pub fn fault(&self, fault: usize) -> Option<(String, &'static str)> {
-        self.faults
-            .get(fault)
-            .map(|f| (f.spec.label(), f.spec.kind.name()))
+        self.injector?.describe(fault)
     }
 
     pub fn record(&self, k: usize) -> Option<&FaultRecord> {
@@ -116,7 +113,7 @@ impl<'w> Engine<'w> {
         let run = RunView {
             meta: &self.meta,
             steps: &self.steps,
-            faults: &self.faults,
+            injector: self.injector.as_deref(),
             records: &self.records,
         };
         for o in &mut self.observers {

@@ -63,8 +63,8 @@ impl<'w> Engine<'w> {
         let ku = k as usize;
         if self.status[iu] != Status::Running {
             self.set(iu, Status::Running);
-            if !self.faults.is_empty() {
-                self.faults_on_step(ku);
+            if self.injector.is_some() {
+                self.inject_on_step(ku);
             }
             self.step_running = Some(k);
             if let Some(st) = self.steps.get_mut(ku) {

@@ -1,57 +1,13 @@
-//! Injected faults: the eight ARIAC 2023 agility challenges in symbolic
-//! form, read from a TOML scenario file (format in `docs/runtime.md`), and
-//! a fault's state at run time. What faults do to a tick is the engine's
-//! faults hook (`engine/faults.rs`).
+//! A fault scenario: the faults of a run, each with its kind, its
+//! trigger and what it changes, read from a TOML file (the format is in
+//! `docs/runtime.md`). Its PDDL text is read here, once.
 
-use crate::error::LoadError;
-use crate::kb::{FormulaId, Kb};
+use super::FaultKind;
 use btc_pddl::diagnostic::codes;
-use btc_pddl::logic::{decode, Atom, Formula, Terms};
+use btc_pddl::logic::{decode, Atom, Formula};
 use btc_pddl::state::Key;
-use serde::{Deserialize, Serialize};
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum FaultKind {
-    RobotMalfunction,
-    FaultyGripper,
-    FaultyPart,
-    FlippedPart,
-    SensorBlackout,
-    HighPriorityOrder,
-    InsufficientParts,
-    HumanTooClose,
-}
-
-impl FaultKind {
-    pub const ALL: [FaultKind; 8] = [
-        FaultKind::RobotMalfunction,
-        FaultKind::FaultyGripper,
-        FaultKind::FaultyPart,
-        FaultKind::FlippedPart,
-        FaultKind::SensorBlackout,
-        FaultKind::HighPriorityOrder,
-        FaultKind::InsufficientParts,
-        FaultKind::HumanTooClose,
-    ];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            FaultKind::RobotMalfunction => "robot_malfunction",
-            FaultKind::FaultyGripper => "faulty_gripper",
-            FaultKind::FaultyPart => "faulty_part",
-            FaultKind::FlippedPart => "flipped_part",
-            FaultKind::SensorBlackout => "sensor_blackout",
-            FaultKind::HighPriorityOrder => "high_priority_order",
-            FaultKind::InsufficientParts => "insufficient_parts",
-            FaultKind::HumanTooClose => "human_too_close",
-        }
-    }
-
-    pub fn from_name(s: &str) -> Option<FaultKind> {
-        FaultKind::ALL.into_iter().find(|k| k.name() == s)
-    }
-}
+use btc_runtime::{Kb, LoadError};
+use serde::Deserialize;
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum Trigger {
@@ -189,7 +145,7 @@ struct FileFault {
     conditions: Option<String>,
 }
 
-pub(crate) fn bad(msg: impl Into<String>) -> LoadError {
+pub(super) fn bad(msg: impl Into<String>) -> LoadError {
     LoadError::new(codes::X_SCENARIO, msg)
 }
 
@@ -329,75 +285,4 @@ impl Scenario {
         }
         Ok(())
     }
-}
-
-/// A fault at run time.
-pub struct FaultRt {
-    pub spec: FaultSpec,
-    pub met_at: Option<u64>,
-    /// The tick at which its effect ends.
-    pub until: Option<u64>,
-    pub ended: bool,
-    pub(crate) seen: u32,
-    pub(crate) pending_fail: bool,
-    /// Facts it removed and added (to undo, and to attribute failures).
-    pub(crate) removed: Vec<Key>,
-    pub(crate) added: Vec<Key>,
-    pub(crate) shown: Vec<String>,
-    pub(crate) goal: Option<FormulaId>,
-}
-
-impl FaultRt {
-    /// A fault that happened outside btc's engine (an embedder's behaviour
-    /// reported it) at tick `met_at`, having removed and added these facts:
-    /// over, with nothing left to do but to be named by what it changed.
-    pub fn reported(
-        spec: FaultSpec,
-        met_at: u64,
-        removed: Vec<Key>,
-        added: Vec<Key>,
-        shown: Vec<String>,
-    ) -> FaultRt {
-        FaultRt {
-            spec,
-            met_at: Some(met_at),
-            until: None,
-            ended: true,
-            seen: 1,
-            pending_fail: false,
-            removed,
-            added,
-            shown,
-            goal: None,
-        }
-    }
-}
-
-/// How a fault ended, for the summary.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct FaultOutcome {
-    pub fault: String,
-    pub kind: FaultKind,
-    pub met_at: Option<u64>,
-    /// `not met`, `recovered` or `not recovered: REASON`.
-    pub ended: String,
-}
-
-/// The met faults that removed or added a fact `lit` mentions, or whose
-/// part or robot it names (`lit`: a goal literal): their labels.
-pub fn naming(faults: &[FaultRt], lit: &Formula) -> Vec<String> {
-    let objects = lit.objects();
-    let text = lit.to_string();
-    faults
-        .iter()
-        .filter(|rt| rt.met_at.is_some())
-        .filter(|rt| {
-            [&rt.spec.part, &rt.spec.robot]
-                .into_iter()
-                .flatten()
-                .any(|o| objects.iter().any(|x| **x == **o))
-                || rt.shown.iter().any(|s| text.contains(s.as_str()))
-        })
-        .map(|rt| rt.spec.label())
-        .collect()
 }
