@@ -3,6 +3,7 @@
 
 use crate::stdout::outln;
 use crate::{domain_lookup, files, paths, report, rules_cmd, Format};
+use btc_agent::faults::{FaultsOnEngine, Scenario};
 use btc_lang::db;
 use btc_lang::path::FilePath;
 use btc_lang::project::PlanSource;
@@ -13,7 +14,7 @@ use btc_pddl::state::World;
 use btc_pddl::world::WorldModel;
 use btc_runtime::btlog::BtlogRecorder;
 use btc_runtime::observers::JsonlTrace;
-use btc_runtime::{Controller, Engine, Kb, LoadError, Loaded, Options, Scenario, Summary, TreeDoc};
+use btc_runtime::{Controller, Engine, Kb, LoadError, Loaded, Options, Summary, TreeDoc};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -521,7 +522,7 @@ fn print_summary(
             Some(t) => format!("met at tick {t}"),
             None => "not met".to_owned(),
         };
-        outln!("fault {} ({}): {met}; {}", f.fault, f.kind.name(), f.ended)?;
+        outln!("fault {} ({}): {met}; {}", f.fault, f.kind, f.ended)?;
     }
     for r in &s.records {
         outln!("{}", record_line(r))?;
@@ -722,7 +723,7 @@ fn print_loop(s: &btc_agent::LoopSummary, problem: &str) -> anyhow::Result<()> {
             Some(t) => format!("met at tick {t}"),
             None => "not met".to_owned(),
         };
-        outln!("fault {} ({}): {met}; {}", f.fault, f.kind.name(), f.ended)?;
+        outln!("fault {} ({}): {met}; {}", f.fault, f.kind, f.ended)?;
     }
     for u in &s.unreachable {
         let by = if u.faults.is_empty() {

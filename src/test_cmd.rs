@@ -11,6 +11,7 @@
 
 use crate::stdout::{out, outln};
 use crate::{report, rules_cmd, Format};
+use btc_agent::faults::FaultsOnEngine;
 use btc_emit as emit;
 use btc_lang::path::FilePath;
 use btc_lang::project::PlanSource;
@@ -119,21 +120,21 @@ fn snapshot_content(text: &str) -> Option<&str> {
 /// goal holds. Ticks are left out: a snapshot of the order changes when
 /// the behaviour does, not when a node is added that takes no tick.
 /// The fault scenario of a case: `STEM.faults.toml` beside its plan.
-fn scenario_of(plan: &Path) -> anyhow::Result<Option<(PathBuf, btc_runtime::Scenario)>> {
+fn scenario_of(plan: &Path) -> anyhow::Result<Option<(PathBuf, btc_agent::faults::Scenario)>> {
     let path = plan.with_extension(&FAULTS[1..]);
     if !path.is_file() {
         return Ok(None);
     }
     let text =
         crate::files::read_text(&path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    let scenario = btc_runtime::Scenario::parse(&text)
+    let scenario = btc_agent::faults::Scenario::parse(&text)
         .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     Ok(Some((path, scenario)))
 }
 
 fn run_text(
     ir: &btc_ir::TreeIr,
-    faults: Option<&(PathBuf, btc_runtime::Scenario)>,
+    faults: Option<&(PathBuf, btc_agent::faults::Scenario)>,
 ) -> anyhow::Result<String> {
     let world = World::new(ir.world.clone()).map_err(anyhow::Error::msg)?;
     let doc = TreeDoc::from_ir(ir);

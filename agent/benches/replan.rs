@@ -6,9 +6,9 @@
 //! - `warm`: the same database reused (only the plan text changes, as in a
 //!   long-running agent), so salsa re-does only what the plan changes.
 
+use btc_agent::faults::Scenario;
 use btc_agent::{run_loop, LoopOptions};
 use btc_lang::db::{CompileJob, Database};
-use btc_agent::faults::Scenario;
 use divan::Bencher;
 use std::path::PathBuf;
 

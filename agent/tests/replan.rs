@@ -2,9 +2,9 @@
 //! (`tests/replan.rs` in the root package) cover every ARIAC scenario; these
 //! check the loop's state handling directly.
 
+use btc_agent::faults::Scenario;
 use btc_agent::{run_loop, LoopOptions};
 use btc_lang::db::{CompileJob, Database};
-use btc_agent::faults::Scenario;
 use btc_runtime::Status;
 use btc_testkit::repo as root;
 

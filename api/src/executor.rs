@@ -5,9 +5,9 @@
 //! the faults its behaviours reported ("the gripper dropped the part").
 
 use crate::tree::Tree;
+use btc_agent::faults::{Blackout, FaultKind, FaultSpec, Trigger};
 use btc_agent::replan as core;
 use btc_pddl::logic::{decode, Formula, InitFact, NumExpr};
-use btc_runtime::faults::{Blackout, FaultKind, FaultSpec, Trigger};
 use btc_runtime::{FaultRecord, Status};
 
 /// Runs the attempts of [`crate::Agent::run_with`].

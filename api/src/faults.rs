@@ -2,8 +2,9 @@
 //! agent meets, read from the TOML form docs/runtime.md describes.
 
 use crate::diagnostic::{Diagnostic, Error, Position};
+use btc_agent::faults::Scenario;
 use btc_pddl::source::SourceFile;
-use btc_runtime::{LoadError, Scenario};
+use btc_runtime::LoadError;
 use std::path::Path;
 
 /// The path scenario texts are reported under.

@@ -3,6 +3,7 @@
 
 use crate::diagnostic::{Diagnostic, Error};
 use crate::faults::Faults;
+use btc_agent::faults::FaultsOnEngine;
 use btc_emit as emit;
 use btc_ir::TreeIr;
 use btc_pddl::state::World;

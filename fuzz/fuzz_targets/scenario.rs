@@ -6,7 +6,8 @@
 mod ariac;
 
 use btc_pddl::source::decode;
-use btc_runtime::{Engine, Kb, Options, Scenario};
+use btc_agent::faults::{FaultsOnEngine, Scenario};
+use btc_runtime::{Engine, Kb, Options};
 use libfuzzer_sys::fuzz_target;
 
 const TREE: &str = r#"<root BTCPP_format="4" main_tree_to_execute="M"><BehaviorTree ID="M"><Sequence><Sleep msec="50"/><AlwaysSuccess/></Sequence></BehaviorTree></root>"#;

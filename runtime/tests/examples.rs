@@ -93,18 +93,18 @@ fn btcpp_xml_runs_exactly_like_its_ir() {
 
 #[test]
 fn xml_steps_check_the_domain_preconditions_like_the_ir() {
-    // A fault that makes the grasp's precondition false: the XML tree (no
-    // plan given) must fail where the IR fails, with the same record.
+    // The part is gone, so the grasp's precondition is false: the XML tree
+    // (no plan given) must fail where the IR fails, with the same record.
     let ex = example("ariac");
     let w = ex.world();
     let text = btc_emit::btcpp::emit(&ex.ir, false);
-    let sc_text =
-        std::fs::read_to_string(root().join("examples/ariac/faults/faulty_part.toml")).unwrap();
-    let sc = btc_runtime::Scenario::parse(&sc_text).unwrap();
     let mut runs = Vec::new();
     for doc in [TreeDoc::from_ir(&ex.ir), ex.xml(&text)] {
         let mut e = traced(ex.engine(&w, &doc, Options::default()));
-        e.add_faults(&sc).unwrap();
+        let kb = e.kb.as_mut().unwrap();
+        let part = kb.object("battery_red").unwrap();
+        let gone = kb.facts_mentioning(part);
+        kb.apply_keys(Vec::new(), gone);
         assert_eq!(e.run(1000, |_| {}), Status::Failure);
         runs.push((jsonl(&e), e.records.clone()));
     }

@@ -4,7 +4,7 @@
 
 use btc_pddl::diagnostic::codes;
 use btc_runtime::engine::MAX_DEPTH;
-use btc_runtime::{load_tree, Engine, Options, Scenario, Status};
+use btc_runtime::{load_tree, Engine, Options, Status};
 use btc_testkit::hostile::{assert_linear, on_small_stack};
 
 fn xml(main: &str, trees: &str) -> String {
@@ -107,23 +107,6 @@ fn many_trees_load_in_linear_time() {
             load_tree(t).expect("loads");
         },
     );
-}
-
-#[test]
-fn scenarios_ten_times_the_limit_are_refused_on_a_small_stack() {
-    let depth = 10 * btc_pddl::limits::MAX_NESTING;
-    for text in [
-        format!("x = {}{}", "[".repeat(depth), "]".repeat(depth)),
-        format!("x = {}1{}", "{ a = ".repeat(depth), " }".repeat(depth)),
-        (0..depth)
-            .map(|i| format!("t{i}"))
-            .collect::<Vec<_>>()
-            .join(".")
-            + " = 1",
-    ] {
-        let r = on_small_stack(move || Scenario::parse(&text).map(|_| ()));
-        assert_eq!(r.expect_err("not a scenario").code, codes::X_SCENARIO);
-    }
 }
 
 /// `--max-ticks 0` ticks nothing (it used to tick once).

@@ -43,7 +43,11 @@ impl FaultsOnEngine for Engine<'_> {
 
     fn wait_for_faults(&mut self, limit: u64) -> u64 {
         let start = self.tick;
-        while self.tick < limit && self.injector::<Faults>().is_some_and(Faults::timed_in_effect) {
+        while self.tick < limit
+            && self
+                .injector::<Faults>()
+                .is_some_and(Faults::timed_in_effect)
+        {
             self.pass_tick();
         }
         self.tick - start

@@ -7,7 +7,7 @@
 
 use super::scenario::{bad, Blackout, FaultSpec, Scenario, Trigger};
 use super::FaultKind;
-use btc_pddl::logic::{Atom, Formula};
+use btc_pddl::logic::{Atom, Formula, Terms};
 use btc_pddl::state::Key;
 use btc_runtime::engine::{ActionLeaf, FaultOutcome, FaultRecord, Injection, Interference};
 use btc_runtime::kb::FormulaId;

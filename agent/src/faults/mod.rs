@@ -11,8 +11,8 @@ mod injector;
 mod kind;
 mod scenario;
 
+pub use btc_runtime::FaultOutcome;
 pub use engine::FaultsOnEngine;
 pub use injector::{FaultRt, Faults};
 pub use kind::FaultKind;
 pub use scenario::{Blackout, FaultSpec, Scenario, Trigger};
-pub use btc_runtime::FaultOutcome;

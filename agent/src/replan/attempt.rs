@@ -6,9 +6,9 @@ use super::carry::{goal_formula, Carry};
 use super::planning::Planned;
 use super::{push_event, Attempt, LoopError, LoopSummary, Run};
 use crate::execution;
+use crate::faults::{FaultKind, FaultsOnEngine};
 use btc_pddl::logic::Formula;
 use btc_runtime::engine::{FaultRecord, Status};
-use crate::faults::{FaultKind, FaultsOnEngine};
 use btc_runtime::observers::JsonlTrace;
 use btc_runtime::{Kb, TreeDoc};
 use std::time::Instant;
@@ -209,7 +209,7 @@ impl Run<'_, '_> {
         let order_faults: Vec<String> = sum
             .faults
             .iter()
-            .filter(|f| f.kind == FaultKind::HighPriorityOrder && f.met_at == Some(end_tick))
+            .filter(|f| f.kind == FaultKind::HighPriorityOrder.name() && f.met_at == Some(end_tick))
             .map(|f| f.fault.clone())
             .collect();
         self.out.faults = engine.fault_outcomes(done);

@@ -3,11 +3,11 @@
 //! replaced by spares, priority orders to reach first).
 
 use super::LoopError;
+use crate::faults::Faults;
 use btc_pddl::diagnostic::codes;
 use btc_pddl::logic::{Formula, Name, Terms};
 use btc_pddl::state::{State, World};
 use btc_runtime::error::LoadError;
-use crate::faults::Faults;
 use btc_runtime::Kb;
 
 /// What carries from one attempt to the next.

@@ -9,6 +9,7 @@
 use super::attempt::{carry_over, Compiled, Ran, RunPart};
 use super::carry::goal_formula;
 use super::{LoopError, Run};
+use crate::faults::{FaultKind, FaultOutcome, FaultSpec, Trigger};
 use btc_ir::TreeIr;
 use btc_lang::db::{CompileJob, Database};
 use btc_pddl::diagnostic::codes;
@@ -16,7 +17,6 @@ use btc_pddl::logic::{Formula, InitFact};
 use btc_pddl::state::Key;
 use btc_runtime::engine::{Engine, FaultRecord, Status};
 use btc_runtime::error::LoadError;
-use crate::faults::{FaultKind, FaultOutcome, FaultSpec, Trigger};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -159,13 +159,7 @@ impl Run<'_, '_> {
                 Trigger::Tick(t) => t,
                 _ => start_tick,
             };
-            happened.push(FaultRt::reported(
-                spec.clone(),
-                met_at,
-                retract.clone(),
-                add.clone(),
-                shown,
-            ));
+            happened.reported(spec.clone(), met_at, retract.clone(), add.clone(), shown);
             kb.apply_keys(add, retract);
             if let (FaultKind::FaultyPart | FaultKind::InsufficientParts, Some(p)) =
                 (spec.kind, &spec.part)
@@ -195,12 +189,13 @@ impl Run<'_, '_> {
             0
         } else {
             let until = happened
+                .list
                 .iter()
                 .filter_map(|rt| Some(rt.met_at? + rt.spec.duration?))
                 .max()
                 .unwrap_or(end_tick)
                 .min(self.opts.max_ticks);
-            for rt in &happened {
+            for rt in &happened.list {
                 if rt.spec.kind == FaultKind::RobotMalfunction {
                     let back = |v: &[btc_pddl::logic::Atom]| -> Vec<Key> {
                         v.iter().filter_map(|a| kb.atom_key(a).ok()).collect()
@@ -296,7 +291,7 @@ impl Run<'_, '_> {
             };
             self.out.faults.push(FaultOutcome {
                 fault: label,
-                kind: spec.kind,
+                kind: spec.kind.name(),
                 met_at: Some(met_at),
                 ended,
             });

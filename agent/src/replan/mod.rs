@@ -20,6 +20,7 @@ mod planning;
 use external::Execution;
 pub use external::{Executed, Executor, Handoff};
 
+use crate::faults::{FaultOutcome, Scenario};
 use btc_lang::db::{self, CompileJob, Database, JobWorld};
 use btc_lang::path::FilePath;
 use btc_pddl::diagnostic::{codes, Diagnostic};
@@ -28,7 +29,6 @@ use btc_pddl::source::Span;
 use btc_pddl::state::World;
 use btc_runtime::engine::{Engine, FaultRecord, Options, Status};
 use btc_runtime::error::LoadError;
-use crate::faults::{FaultOutcome, Scenario};
 use carry::Carry;
 use planning::Planned;
 use serde::Serialize;

@@ -120,7 +120,7 @@ fn unsolvable_message(un: &[Unreachable], carry: &Carry, at_start: bool) -> Stri
     let in_effect = carry
         .faults
         .iter()
-        .flatten()
+        .flat_map(|f| &f.list)
         .filter(|rt| rt.met_at.is_some() && !rt.ended)
         .map(|rt| rt.spec.label());
     let mut faults: Vec<String> = Vec::new();
@@ -164,7 +164,8 @@ fn unreachable(
     for part in goal.conjuncts() {
         literals.extend(part.conjuncts().iter().cloned());
     }
-    let faults = carry.faults.as_deref().unwrap_or(&[]);
+    let none = crate::faults::Faults::default();
+    let faults = carry.faults.as_ref().unwrap_or(&none);
     let mut out = Vec::new();
     for lit in literals {
         let r = execution::plan(PlanningWorld::from(w), &kb.state, &lit, span, &opts.planner)
@@ -172,7 +173,7 @@ fn unreachable(
         if matches!(r, Planning::Unsolvable { .. }) {
             out.push(Unreachable {
                 literal: lit.to_string(),
-                faults: btc_runtime::faults::naming(faults, &lit),
+                faults: faults.naming(&lit),
             });
         }
     }

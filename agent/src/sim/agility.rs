@@ -8,9 +8,9 @@ use super::events::{ChallengeEvent, Event};
 use super::model::Sim;
 use super::world::PartId;
 use crate::cell::Var;
+use crate::faults::{FaultKind, FaultSpec, FaultsOnEngine, Scenario};
 use crate::trial::{Condition, Robot, Task as OrderTask};
 use btc_pddl::state::Key;
-use crate::faults::{FaultKind, FaultSpec, FaultsOnEngine, Scenario};
 
 impl Sim<'_, '_> {
     /// Challenges on the clock: effects that end, drops that come, time

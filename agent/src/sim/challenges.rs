@@ -10,8 +10,8 @@
 use super::tasks::PartId;
 use crate::cell::spec::Time;
 use crate::cell::{Cell, Origin, PartInfo};
-use crate::trial::{Behavior, ChallengeKind, Condition, PartKind, Robot, Trial};
 use crate::faults::{Blackout, FaultKind, FaultSpec, Trigger};
+use crate::trial::{Behavior, ChallengeKind, Condition, PartKind, Robot, Trial};
 
 /// ARIAC's faulty parts: the first part placed in each flagged quadrant of
 /// the order's kit is faulty.

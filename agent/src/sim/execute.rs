@@ -13,10 +13,10 @@ use super::model::Sim;
 use super::tasks::{Attempt, PartId, Resource, TaskId, TaskState};
 use crate::cell::{conjunction, Literal, Var};
 use crate::execution::{self, Planning, PlanningWorld};
+use crate::faults::{FaultsOnEngine, Scenario};
 use btc_pddl::source::Span;
 use btc_pddl::state::Key;
 use btc_runtime::observers::JsonlTrace;
-use crate::faults::{FaultsOnEngine, Scenario};
 use btc_runtime::{Engine, Kb, Options, Status, TreeDoc};
 
 impl<'w> Sim<'w, '_> {

@@ -209,7 +209,10 @@ impl<'w> Engine<'w> {
             .collect();
         let ports: Vec<&str> = texts.iter().map(|t| &**t).collect();
         let id = self.actions[a as usize].id.clone();
-        let leaf = ActionLeaf { id: &id, ports: &ports };
+        let leaf = ActionLeaf {
+            id: &id,
+            ports: &ports,
+        };
         match self.with_injector(|inj, run| inj.action(run, &leaf, fresh))? {
             None => None,
             Some(Interference::Wait) => Some(Status::Running),

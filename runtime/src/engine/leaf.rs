@@ -215,5 +215,4 @@ impl<'w> Engine<'w> {
         let p = &self.ports[port as usize];
         self.value(&p.src)
     }
-
 }

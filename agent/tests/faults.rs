@@ -1,9 +1,57 @@
 //! Each ARIAC fault kind has a scenario under `examples/ariac/faults/`,
 //! run here on the ARIAC example with its expected outcome.
 
-mod common;
-use btc_runtime::{FaultKind, Options, Scenario, Status, TreeDoc, Value};
-use common::*;
+use btc_agent::faults::{FaultKind, FaultsOnEngine, Scenario};
+use btc_ir::TreeIr;
+use btc_lang::db::{self, CompileJob, Database, JobWorld};
+use btc_pddl::state::World;
+use btc_runtime::observers::JsonlTrace;
+use btc_runtime::{Engine, Kb, Options, Status, TreeDoc, Value};
+use btc_testkit::repo as root;
+
+/// The ARIAC example compiled: its rules, domain, problem and plan.
+struct Ariac {
+    db: Database,
+    job: CompileJob,
+    ir: TreeIr,
+}
+
+fn ariac() -> Ariac {
+    let dir = root().join("examples/ariac");
+    let mut db = Database::new();
+    let mut load = |name: &str| {
+        let p = dir.join(name);
+        db.set_file(&p, std::fs::read_to_string(&p).unwrap())
+    };
+    let (rules, domain) = (load("rules.btrules"), load("domain.pddl"));
+    let (problem, plan) = (load("problem.pddl"), load("plan.txt"));
+    let job = CompileJob::new(&db, rules, plan, Some(problem), Some(domain));
+    let ir = db::compile(&db, job).as_ref().unwrap().as_ref().clone();
+    Ariac { db, job, ir }
+}
+
+impl Ariac {
+    fn world(&self) -> World {
+        JobWorld::of(&self.db, self.job).unwrap().world().unwrap()
+    }
+
+    /// An engine over `w` for the example's tree, with a JSON Lines trace.
+    fn engine<'w>(&self, w: &'w World) -> Engine<'w> {
+        let doc = TreeDoc::from_ir(&self.ir);
+        let mut e = Engine::build(&doc, Some(Kb::new(w)), Options::default()).unwrap();
+        e.observe(JsonlTrace::default());
+        e
+    }
+}
+
+fn jsonl(e: &Engine<'_>) -> String {
+    e.observer::<JsonlTrace>().unwrap().text().to_owned()
+}
+
+fn fixture(name: &str) -> String {
+    let p = root().join("agent/tests/fixtures").join(name);
+    std::fs::read_to_string(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+}
 
 enum Expect {
     /// The tree recovers: success, the goal holds, later than the plain run
@@ -50,10 +98,9 @@ fn scenario(kind: FaultKind) -> Scenario {
 
 #[test]
 fn every_fault_kind_has_a_scenario_with_its_outcome() {
-    let ex = example("ariac");
+    let ex = ariac();
     let w = ex.world();
-    let doc = TreeDoc::from_ir(&ex.ir);
-    let mut plain = traced(ex.engine(&w, &doc, Options::default()));
+    let mut plain = ex.engine(&w);
     let s = plain.run(10_000, |_| {});
     assert_eq!(s, Status::Success);
     let baseline = plain.tick;
@@ -62,7 +109,7 @@ fn every_fault_kind_has_a_scenario_with_its_outcome() {
         let sc = scenario(kind);
         assert_eq!(sc.faults.len(), 1, "{kind:?}");
         assert_eq!(sc.faults[0].kind, kind);
-        let mut e = traced(ex.engine(&w, &doc, Options::default()));
+        let mut e = ex.engine(&w);
         e.add_faults(&sc).unwrap();
         let s = e.run(10_000, |_| {});
         let sum = e.summary(s);
@@ -116,10 +163,9 @@ fn every_fault_kind_has_a_scenario_with_its_outcome() {
 
 #[test]
 fn a_malfunction_is_repaired_after_its_duration() {
-    let ex = example("ariac");
+    let ex = ariac();
     let w = ex.world();
-    let doc = TreeDoc::from_ir(&ex.ir);
-    let mut e = traced(ex.engine(&w, &doc, Options::default()));
+    let mut e = ex.engine(&w);
     e.add_faults(&scenario(FaultKind::RobotMalfunction))
         .unwrap();
     e.run(10_000, |_| {});
@@ -143,9 +189,9 @@ fn a_malfunction_is_repaired_after_its_duration() {
 
 #[test]
 fn a_blackout_that_fails_conditions_fails_the_monitor() {
-    let ex = example("ariac");
+    let ex = ariac();
     let w = ex.world();
-    let mut e = traced(ex.engine(&w, &TreeDoc::from_ir(&ex.ir), Options::default()));
+    let mut e = ex.engine(&w);
     let sc = Scenario::parse(&fixture("faults/blackout_failure.toml")).unwrap();
     e.add_faults(&sc).unwrap();
     let s = e.run(10_000, |_| {});
@@ -168,9 +214,9 @@ fn bad_scenarios_are_refused_with_a_code() {
         assert!(e.message.contains(needle), "{file}: {}", e.message);
     }
     // Facts are checked against the problem.
-    let ex = example("ariac");
+    let ex = ariac();
     let w = ex.world();
-    let mut eng = traced(ex.engine(&w, &TreeDoc::from_ir(&ex.ir), Options::default()));
+    let mut eng = ex.engine(&w);
     let sc = Scenario::parse(&fixture("faults/unknown_fact.toml")).unwrap();
     let err = eng.add_faults(&sc).unwrap_err();
     assert_eq!(err.code.id, "X006");
