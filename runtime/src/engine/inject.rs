@@ -130,9 +130,7 @@ impl<'w> Engine<'w> {
     /// Takes the injector back, if it is of type `I`: the engine keeps no
     /// faults after.
     pub fn take_injector<I: Injector>(&mut self) -> Option<I> {
-        if self.injector::<I>().is_none() {
-            return None;
-        }
+        self.injector::<I>()?;
         let b: Box<dyn Any> = self.injector.take()?;
         self.inject_live = false;
         b.downcast::<I>().ok().map(|b| *b)
