@@ -105,7 +105,34 @@ pub(super) struct Ran {
     pub last_record: Option<FaultRecord>,
 }
 
+/// What an attempt's run decides beyond its record.
+pub(super) struct Outcome {
+    pub done: bool,
+    pub preempting: Vec<Formula>,
+    pub order_faults: Vec<String>,
+    pub discarded: Vec<(String, String)>,
+    pub added: Vec<Formula>,
+}
+
 impl Run<'_, '_> {
+    /// Records attempt `c` as `part` ran it (in btc's engine or outside),
+    /// and says what it ended in.
+    pub(super) fn close(&mut self, c: Compiled, part: RunPart, o: Outcome) -> Ran {
+        let ran = Ran {
+            status: part.status,
+            done: o.done,
+            preempted: part.preempted,
+            preempting: o.preempting,
+            order_faults: o.order_faults,
+            discarded: o.discarded,
+            added: o.added,
+            end_tick: part.end_tick,
+            last_record: part.records.last().cloned(),
+        };
+        self.out.attempts.push(c.record(part));
+        ran
+    }
+
     /// Compiles and runs attempt `attempt` for `goal`, and records it.
     pub(super) fn attempt(
         &mut self,
@@ -221,27 +248,28 @@ impl Run<'_, '_> {
         let reached = done && !c.for_priority;
         let added = carry_over(&mut self.carry, &mut self.out, kb, engine.tick, reached);
         self.carry.faults = Some(engine.take_faults());
-        self.out.attempts.push(c.record(RunPart {
-            run_ms,
-            start_tick,
-            end_tick,
-            status,
-            steps_done: sum.steps_done,
-            steps_total: sum.steps_total,
-            records: sum.records.clone(),
-            waited_ticks: waited,
-            preempted,
-        }));
-        Ok(Ran {
-            status,
-            done,
-            preempted,
-            preempting,
-            order_faults,
-            discarded,
-            added,
-            end_tick,
-            last_record: sum.records.last().cloned(),
-        })
+        // The engine borrows the shared world the record is kept beside.
+        drop(engine);
+        Ok(self.close(
+            c,
+            RunPart {
+                run_ms,
+                start_tick,
+                end_tick,
+                status,
+                steps_done: sum.steps_done,
+                steps_total: sum.steps_total,
+                records: sum.records.clone(),
+                waited_ticks: waited,
+                preempted,
+            },
+            Outcome {
+                done,
+                preempting,
+                order_faults,
+                discarded,
+                added,
+            },
+        ))
     }
 }

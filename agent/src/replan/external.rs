@@ -6,7 +6,7 @@
 //! KB as the same fault in a scenario would, a discarded part gets a spare,
 //! an order's goal comes first.
 
-use super::attempt::{carry_over, Compiled, Ran, RunPart};
+use super::attempt::{carry_over, Compiled, Outcome, Ran, RunPart};
 use super::carry::goal_formula;
 use super::{LoopError, Run};
 use crate::faults::{FaultKind, FaultOutcome, FaultSpec, Trigger};
@@ -221,28 +221,28 @@ impl Run<'_, '_> {
         self.carry.faults = Some(happened);
         self.note_reported(&ex, start_tick, done);
         let steps_total = ir.steps.len();
-        self.out.attempts.push(c.record(RunPart {
-            run_ms,
-            start_tick,
-            end_tick,
-            status,
-            steps_done: ex.steps_done.min(steps_total),
-            steps_total,
-            records: ex.records.clone(),
-            waited_ticks: waited,
-            preempted,
-        }));
-        Ok(Ran {
-            status,
-            done,
-            preempted,
-            preempting,
-            order_faults: if preempted { orders } else { Vec::new() },
-            discarded,
-            added,
-            end_tick,
-            last_record: ex.records.last().cloned(),
-        })
+        let order_faults = if preempted { orders } else { Vec::new() };
+        Ok(self.close(
+            c,
+            RunPart {
+                run_ms,
+                start_tick,
+                end_tick,
+                status,
+                steps_done: ex.steps_done.min(steps_total),
+                steps_total,
+                records: ex.records.clone(),
+                waited_ticks: waited,
+                preempted,
+            },
+            Outcome {
+                done,
+                preempting,
+                order_faults,
+                discarded,
+                added,
+            },
+        ))
     }
 
     /// A reported fault is held to what a scenario's fault must say, and
