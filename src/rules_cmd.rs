@@ -134,6 +134,26 @@ pub fn load_job(
     domain: Option<&Path>,
     allow_invalid_plan: bool,
 ) -> anyhow::Result<Job> {
+    // Replaying a long plan (a timed one especially) takes as long as
+    // lowering it: on a second core the tree is lowered meanwhile,
+    // memoized for `tree_of` (and unused if the job is refused).
+    let lower = |db: &Database, job| {
+        let _ = db::compile(db, job);
+    };
+    load_job_then(rules, plan, problem, domain, allow_invalid_plan, lower).map(|(job, _)| job)
+}
+
+/// [`load_job`], with `meanwhile` run on a second core, on a clone of the
+/// database, while the plan is replayed; what it returns comes back beside
+/// the job (`None` for a plan still to be made: nothing to replay).
+fn load_job_then<T: Send>(
+    rules: &Path,
+    plan: PlanSource,
+    problem: Option<&Path>,
+    domain: Option<&Path>,
+    allow_invalid_plan: bool,
+    meanwhile: impl FnOnce(&Database, db::CompileJob) -> T + Send,
+) -> anyhow::Result<(Job, Option<T>)> {
     let mut database = Database::new();
     let planned = matches!(plan, PlanSource::Planned(_));
     let paths = JobPaths {
@@ -146,27 +166,23 @@ pub fn load_job(
         .map_err(files::unreadable_job_file)?;
     let job = loaded.job;
     let plan_file = db::file_id(&database, job.plan(&database));
-    // Replaying a long plan (a timed one especially) takes as long as
-    // lowering it: on a second core the tree is lowered meanwhile,
-    // memoized for `tree_of` (and unused if the job is refused).
-    let lowering = (!planned).then(|| database.clone());
-    let mut diagnostics: Vec<Diagnostic> = std::thread::scope(|s| {
-        if let Some(lowering) = lowering {
-            s.spawn(move || {
-                let _ = db::compile(&lowering, job);
-            });
-        }
-        diagnostics_of(&database, job, planned, plan_file, allow_invalid_plan)
+    let beside = (!planned).then(|| database.clone());
+    let (mut diagnostics, made) = std::thread::scope(|s| {
+        let made = beside.map(|db| s.spawn(move || meanwhile(&db, job)));
+        let diagnostics = diagnostics_of(&database, job, planned, plan_file, allow_invalid_plan);
+        // A panic there is met again, and reported, on the way without it.
+        (diagnostics, made.and_then(|m| m.join().ok()))
     });
     if project::load_neighbours_if_wanted(&mut database, &files::Disk, &loaded, &paths) {
         // The replay's advice names the problems beside the plan it fits.
         diagnostics = diagnostics_of(&database, job, planned, plan_file, allow_invalid_plan);
     }
-    Ok(Job {
+    let job = Job {
         db: database,
         loaded,
         diagnostics,
-    })
+    };
+    Ok((job, made))
 }
 
 /// What checking the job and replaying its plan say.
@@ -241,13 +257,29 @@ pub fn record_paths_from(ir: &mut btc_ir::TreeIr, base: &Path) {
 }
 
 pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
-    let mut job = load_job(
+    let (mut job, made) = load_job_then(
         &a.rules,
         PlanSource::File(FilePath::new(&a.plan)),
         a.problem.as_deref(),
         a.domain.as_deref(),
         a.allow_invalid_plan,
+        |db, job| emit_meanwhile(db, job, a),
     )?;
+    if let Some(made) = made.flatten() {
+        if !has_errors(&job.diagnostics) {
+            let sources = job.db.sources_for(&job.diagnostics);
+            report::diagnostics(&job.diagnostics, &sources, a.format);
+            let what = made.counts.summary(&job.problem_shown());
+            let out = made.staged.target().to_path_buf();
+            made.staged
+                .commit()
+                .map_err(|e| anyhow::anyhow!("cannot write `{}`: {e}", out.display()))?;
+            wrote(a, &out, &what)?;
+            // The process ends here: the OS reclaims the database at once.
+            std::mem::forget(job);
+            return Ok(ExitCode::SUCCESS);
+        }
+    }
     let result = tree_of(&mut job, a.emit == Output::Tree(emit::Format::Pytrees));
     let sources = job.db.sources_for(&job.diagnostics);
     let json = report::diagnostics(&job.diagnostics, &sources, a.format);
@@ -264,13 +296,7 @@ pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
         }
         return Ok(ExitCode::from(1));
     };
-    let steps = ir.steps.iter().filter(|s| !s.skipped).count();
-    let what = format!(
-        "{steps} of {} plan steps ({} skipped); problem {}",
-        ir.steps.len(),
-        ir.steps.len() - steps,
-        job.problem_shown()
-    );
+    let what = StepCounts::of(&ir).summary(&job.problem_shown());
     let current = match a.emit {
         Output::Tree(f) => {
             // A tree's emitter reads the IR alone: the plan's text, parse
@@ -324,14 +350,7 @@ fn deliver(
         eprintln!("compiled {}: {what}", a.plan.display());
         return Ok(true);
     };
-    // An imported runtime goes beside the module, where its import finds
-    // it; it is btc's file and always rewritten.
-    let runtime = (a.emit == Output::Tree(emit::Format::Pytrees)
-        && a.options.runtime == emit::pytrees::Runtime::Import)
-        .then(|| {
-            let dir = out.parent().unwrap_or(Path::new(""));
-            dir.join(format!("{}.py", emit::pytrees::RUNTIME_MODULE))
-        });
+    let runtime = runtime_beside(a, out);
     if a.check {
         let mut current = true;
         let mut runtime_text =
@@ -356,12 +375,97 @@ fn deliver(
         return Ok(current);
     }
     files::write_produced(out, produce)?;
+    wrote(a, out, what)?;
+    Ok(true)
+}
+
+/// Says that `out` was written, and writes the imported py_trees runtime
+/// beside it (btc's file, always rewritten) when the output imports it.
+fn wrote(a: &CompileArgs, out: &Path, what: &str) -> anyhow::Result<()> {
     eprintln!("wrote {}: {what}", out.display());
-    if let Some(rt) = runtime {
+    if let Some(rt) = runtime_beside(a, out) {
         files::write_atomically(&rt, emit::pytrees::RUNTIME)?;
         eprintln!("wrote {}", rt.display());
     }
-    Ok(true)
+    Ok(())
+}
+
+/// An imported runtime goes beside the module, where its import finds it;
+/// it is btc's file and always rewritten.
+fn runtime_beside(a: &CompileArgs, out: &Path) -> Option<PathBuf> {
+    (a.emit == Output::Tree(emit::Format::Pytrees)
+        && a.options.runtime == emit::pytrees::Runtime::Import)
+        .then(|| {
+            let dir = out.parent().unwrap_or(Path::new(""));
+            dir.join(format!("{}.py", emit::pytrees::RUNTIME_MODULE))
+        })
+}
+
+/// An output made on the second core while the plan was replayed, in a
+/// temporary file beside its target, and its plan's step counts.
+struct Made {
+    staged: btc_files::Staged,
+    counts: StepCounts,
+}
+
+/// A tree's plan steps, and how many of them its rules skip.
+#[derive(Clone, Copy)]
+struct StepCounts {
+    steps: usize,
+    skipped: usize,
+}
+
+impl StepCounts {
+    fn of(ir: &btc_ir::TreeIr) -> StepCounts {
+        StepCounts {
+            steps: ir.steps.len(),
+            skipped: ir.steps.iter().filter(|s| s.skipped).count(),
+        }
+    }
+
+    /// `N of M plan steps (K skipped); problem P`: what a compile says.
+    fn summary(self, problem: &str) -> String {
+        format!(
+            "{} of {} plan steps ({} skipped); problem {problem}",
+            self.steps - self.skipped,
+            self.steps,
+            self.skipped
+        )
+    }
+}
+
+/// For `btc compile -o FILE` of a tree: lowers the job and emits it into
+/// a temporary file beside FILE, while the main thread replays the plan,
+/// so that a long plan's emit is off the critical path. `None` where the
+/// output must wait for the verdict: `--check`, standard output, `--emit
+/// kb`, a folder still to be created (a refused job creates nothing), a
+/// target not replaced atomically, a job that does not lower or that a
+/// py_trees module cannot express (the usual way then reports why).
+fn emit_meanwhile(db: &Database, job: db::CompileJob, a: &CompileArgs) -> Option<Made> {
+    let (Output::Tree(format), Some(out), false) = (a.emit, a.output.as_deref(), a.check) else {
+        return None;
+    };
+    if !out
+        .parent()
+        .is_none_or(|d| d.as_os_str().is_empty() || d.is_dir())
+    {
+        return None;
+    }
+    let mut ir = db::lower_job(db, job).ok()?;
+    if format == emit::Format::Pytrees
+        && !targets::refusals(db, job, &ir, targets::Target::Pytrees).is_empty()
+    {
+        return None;
+    }
+    record_paths_from(&mut ir, output_folder(a));
+    let staged = btc_files::stage(out, &mut |w| emit::emit_to(&ir, format, &a.options, w));
+    let made = Made {
+        staged: staged.ok()??,
+        counts: StepCounts::of(&ir),
+    };
+    // The process ends soon: the OS reclaims the IR at once.
+    std::mem::forget(ir);
+    Some(made)
 }
 
 /// `btc fmt [--check] FILES`: formats in place (atomically), or with

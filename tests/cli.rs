@@ -137,6 +137,77 @@ fn output_files_are_written_whole_or_not_at_all() {
     );
 }
 
+/// `btc compile -o` lowers and emits on a second core while it replays
+/// the plan, into a temporary file: a plan the replay refuses leaves the
+/// old output as it was and nothing beside it, though its tree lowered;
+/// an accepted one writes the same bytes as standard output gets.
+#[test]
+fn an_output_made_while_the_plan_is_replayed_lands_only_if_the_plan_is_accepted() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("tree.py");
+    std::fs::write(&out, "previous contents").unwrap();
+    let compile = |plan: &str, extra: &[&str]| {
+        let mut args = vec![
+            "compile",
+            "examples/p3_assembler/rules.btrules",
+            "--plan",
+            plan,
+            "--problem",
+            "examples/p3_assembler/problem.pddl",
+            "--emit",
+            "pytrees",
+        ];
+        args.extend_from_slice(extra);
+        btc(&args)
+    };
+    let refused = compile(
+        "tests/fixtures/cli/p3_refused.tplan",
+        &["-o", out.to_str().unwrap()],
+    );
+    assert_eq!(refused.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert!(stderr.contains("does not hold"), "{stderr}");
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), "previous contents");
+    let names = |d: &Path| -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(d)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    };
+    assert_eq!(names(dir.path()), ["tree.py"]);
+
+    let plan = "examples/p3_assembler/plan.tplan";
+    let accepted = compile(plan, &["-o", out.to_str().unwrap()]);
+    assert!(accepted.status.success());
+    assert_ne!(std::fs::read_to_string(&out).unwrap(), "previous contents");
+    assert_eq!(names(dir.path()), ["tree.py"]);
+    // The same bytes as the way that waits for the verdict (taken when the
+    // output's folder is still to be created), its paths recorded alike.
+    let (made, waited) = (dir.path().join("a"), dir.path().join("b"));
+    std::fs::create_dir(&made).unwrap();
+    for d in [&made, &waited] {
+        let o = d.join("tree.py");
+        let args = [
+            "--runtime",
+            "import",
+            "--source-paths",
+            "-o",
+            o.to_str().unwrap(),
+        ];
+        assert!(compile(plan, &args).status.success());
+        // An imported runtime is written beside the module either way.
+        assert_eq!(names(d), ["btc_runtime.py", "tree.py"]);
+    }
+    let tree = std::fs::read_to_string(made.join("tree.py")).unwrap();
+    assert!(tree.contains("# problem: \"../"), "{tree}");
+    assert_eq!(
+        tree,
+        std::fs::read_to_string(waited.join("tree.py")).unwrap()
+    );
+}
+
 /// `compile --check -o FILE` is CI's "is the committed tree current": exit
 /// 1 when FILE is missing or would change, 0 when it would not, and never a
 /// byte written (nor the py_trees runtime an imported module needs).

@@ -17,4 +17,4 @@ pub mod write;
 
 pub use compare::{would_change, Comparison};
 pub use read::{read, ReadError};
-pub use write::{write, write_with, Stream};
+pub use write::{stage, write, write_with, Staged, Stream};

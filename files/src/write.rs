@@ -78,7 +78,7 @@ pub fn write_with(path: &Path, produce: &mut Produce<'_>) -> io::Result<()> {
     match plan(&target)? {
         Plan::InPlace { truncate } => in_place(&target, produce, truncate),
         Plan::Atomic(old) => match atomic(&target, produce, old)? {
-            Done::Written => Ok(()),
+            Done::Written(()) => Ok(()),
             // The folder is read-only (or the owner cannot be kept), but
             // the file itself may well be writable.
             Done::Refused(e) if old.is_some() => in_place(&target, produce, true).map_err(|_| e),
@@ -96,8 +96,8 @@ fn in_place(target: &Path, produce: &mut Produce<'_>, truncate: bool) -> io::Res
     f.flush()
 }
 
-enum Done {
-    Written,
+enum Done<T> {
+    Written(T),
     /// The atomic way is closed (no temporary file, no owner): the caller
     /// may write in place.
     Refused(io::Error),
@@ -115,11 +115,62 @@ fn temp_path(target: &Path, attempt: u32) -> PathBuf {
     }
 }
 
+/// An output written in full to a temporary file beside its target, not
+/// yet in the target's place: [`Staged::commit`] renames it there, and
+/// dropping it removes it. A command can so make an output while it is
+/// still checking whether it may write one (`btc compile` emits while it
+/// replays the plan) and leave nothing behind when it may not.
+pub struct Staged {
+    guard: cleanup::TempGuard,
+    target: PathBuf,
+}
+
+impl Staged {
+    /// Puts the output in its target's place.
+    pub fn commit(self) -> io::Result<()> {
+        std::fs::rename(self.guard.path(), &self.target)?;
+        self.guard.keep();
+        Ok(())
+    }
+
+    /// The file the output will replace.
+    pub fn target(&self) -> &Path {
+        &self.target
+    }
+}
+
+/// Writes what `produce` makes to a temporary file beside `path`, for
+/// [`Staged::commit`] to put in place. `Ok(None)` when `path` is not
+/// replaced atomically (a special file, several hard links, a folder btc
+/// may not create files in): then [`write_with`] is the way, at the time
+/// the output may be written. If `produce` fails, nothing is left behind.
+pub fn stage(path: &Path, produce: &mut Produce<'_>) -> io::Result<Option<Staged>> {
+    let target = resolve(path)?;
+    let Plan::Atomic(old) = plan(&target)? else {
+        return Ok(None);
+    };
+    Ok(match staged(&target, produce, old)? {
+        Done::Written(s) => Some(s),
+        Done::Refused(_) => None,
+    })
+}
+
 fn atomic(
     target: &Path,
     produce: &mut Produce<'_>,
     old: Option<(u32, u32, u32)>,
-) -> io::Result<Done> {
+) -> io::Result<Done<()>> {
+    Ok(match staged(target, produce, old)? {
+        Done::Written(s) => Done::Written(s.commit()?),
+        Done::Refused(e) => Done::Refused(e),
+    })
+}
+
+fn staged(
+    target: &Path,
+    produce: &mut Produce<'_>,
+    old: Option<(u32, u32, u32)>,
+) -> io::Result<Done<Staged>> {
     let (guard, mut file) = {
         let mut attempt = 0;
         loop {
@@ -163,9 +214,10 @@ fn atomic(
     }
     produce(&mut file)?;
     drop(file);
-    std::fs::rename(guard.path(), target)?;
-    guard.keep();
-    Ok(Done::Written)
+    Ok(Done::Written(Staged {
+        guard,
+        target: target.to_path_buf(),
+    }))
 }
 
 /// An output written as it is produced (a run's trace): every line handed

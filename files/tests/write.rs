@@ -1,7 +1,7 @@
 //! The writer keeps what a rename would destroy: modes, owners, links,
 //! special files; and it is atomic for regular files.
 
-use btc_files::{write, write_with, Stream};
+use btc_files::{stage, write, write_with, Stream};
 use std::os::unix::fs::{MetadataExt, PermissionsExt};
 use std::path::Path;
 use std::process::Command;
@@ -63,6 +63,41 @@ fn a_failed_output_leaves_the_old_file() {
     assert_eq!(err.to_string(), "disk full");
     assert_eq!(std::fs::read(&p).unwrap(), b"old");
     assert!(leftovers(dir.path()).is_empty());
+}
+
+/// A staged output waits beside its target: the old file stays as it was
+/// until the commit, and an output never committed leaves nothing.
+#[test]
+fn a_staged_output_lands_on_commit_and_is_gone_if_dropped() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("out.xml");
+    std::fs::write(&p, b"old").unwrap();
+    let dropped = stage(&p, &mut |w| w.write_all(b"refused"))
+        .unwrap()
+        .unwrap();
+    assert_eq!(leftovers(dir.path()).len(), 1);
+    assert_eq!(std::fs::read(&p).unwrap(), b"old");
+    drop(dropped);
+    assert!(leftovers(dir.path()).is_empty());
+    assert_eq!(std::fs::read(&p).unwrap(), b"old");
+
+    let staged = stage(&p, &mut |w| w.write_all(b"new")).unwrap().unwrap();
+    assert_eq!(staged.target(), p);
+    assert_eq!(std::fs::read(&p).unwrap(), b"old");
+    staged.commit().unwrap();
+    assert_eq!(std::fs::read(&p).unwrap(), b"new");
+    assert!(leftovers(dir.path()).is_empty());
+
+    let failed = stage(&p, &mut |_| Err(std::io::Error::other("disk full")));
+    assert_eq!(
+        failed.err().map(|e| e.to_string()).as_deref(),
+        Some("disk full")
+    );
+    assert!(leftovers(dir.path()).is_empty());
+    // What a rename would damage is not staged: it is written at the end.
+    assert!(stage(Path::new("/dev/null"), &mut |w| w.write_all(b"x"))
+        .unwrap()
+        .is_none());
 }
 
 #[test]

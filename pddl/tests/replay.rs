@@ -1,5 +1,6 @@
 //! The cached replay against the general one: for the examples' plans, the
-//! fixtures in `tests/fixtures/replay/`, the IPC corpus' plans, and plans
+//! fixtures in `tests/fixtures/replay/` and the timed ones in
+//! `tests/fixtures/timed/`, the IPC corpus' plans, and plans
 //! mutated to fail at every step, both give the same `Validation` (the same
 //! cost, steps and diagnostics, to the letter). The fixtures' expected
 //! outcomes are also stated, so that a fault both replays share shows.
@@ -266,6 +267,27 @@ fn the_examples_plans_and_their_mutants_replay_alike() {
         }
     }
     assert!(replayed > 80, "only {replayed} example plans replayed");
+}
+
+/// Timed plans: concurrent and overlapping actions, `over all` conditions
+/// broken by another action's event, wrong durations; their mutants put
+/// two steps at one time, drop one, or swap two.
+#[test]
+fn the_timed_fixtures_and_their_mutants_replay_alike() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/timed");
+    let mut s = Setting::load(&dir.join("domain.pddl"), &dir.join("p1.pddl"));
+    let mut replayed = 0;
+    let mut refused = 0;
+    for plan in btc_testkit::sorted_entries(&dir)
+        .into_iter()
+        .filter(|p| file_name(p).starts_with("p1.") && file_name(p).ends_with(".tplan"))
+    {
+        let text = read(&plan);
+        refused += usize::from(!s.replay(&file_name(&plan), &text).valid);
+        replayed += s.replay_with_mutants(&file_name(&plan), &text);
+    }
+    assert!(replayed > 100, "only {replayed} timed plans replayed");
+    assert!(refused >= 5, "only {refused} fixtures refused");
 }
 
 #[test]

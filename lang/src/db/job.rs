@@ -109,6 +109,13 @@ pub fn typed_plan(db: &dyn Db, job: CompileJob) -> TypedPlan {
 /// emitter needs none of them (`btc compile` frees them before it writes).
 #[salsa::tracked(returns(ref))]
 pub fn compile(db: &dyn Db, job: CompileJob) -> Result<Arc<btc_ir::TreeIr>, Vec<Diagnostic>> {
+    lower_job(db, job).map(Arc::new)
+}
+
+/// [`compile`], not memoized: the IR is the caller's alone (no copy to
+/// change it), and the database keeps none. `btc compile -o` lowers and
+/// emits this way on a second core while the plan is replayed.
+pub fn lower_job(db: &dyn Db, job: CompileJob) -> Result<btc_ir::TreeIr, Vec<Diagnostic>> {
     let diags = job_diagnostics(db, job);
     if btc_pddl::diagnostic::has_errors(diags) {
         return Err(diags.iter().filter(|d| d.is_error()).cloned().collect());
@@ -151,5 +158,5 @@ pub fn compile(db: &dyn Db, job: CompileJob) -> Result<Arc<btc_ir::TreeIr>, Vec<
         plan_path: job.plan(db).path(db).to_string(),
         rules_path: rules.path(db).to_string(),
     };
-    crate::lower::lower(&input).map(Arc::new)
+    crate::lower::lower(&input)
 }

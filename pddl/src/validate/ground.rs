@@ -72,16 +72,34 @@ impl<'s> GroundActions<'s> {
         args: &'s [u32],
         state: &State,
     ) -> (&GroundAction, &mut TrackedFacts) {
+        let i = self.id(action, compiled, args, state);
+        self.parts(i)
+    }
+
+    /// [`GroundActions::get`]'s ground action as an id for
+    /// [`GroundActions::parts`]: a replay that meets a step several times
+    /// (a durative action's start, end and `over all`) looks it up once.
+    pub fn id(
+        &mut self,
+        action: usize,
+        compiled: &CompiledAction,
+        args: &'s [u32],
+        state: &State,
+    ) -> usize {
         let address = (action, args.as_ptr(), args.len());
-        let i = match self.by_address.get(&address) {
+        match self.by_address.get(&address) {
             Some(&i) => i,
             None => {
                 let i = self.by_content(action, compiled, args, state);
                 self.by_address.insert(address, i);
                 i
             }
-        };
-        (&self.actions[i], &mut self.facts)
+        }
+    }
+
+    /// Ground action `id` and the atoms' table.
+    pub fn parts(&mut self, id: usize) -> (&GroundAction, &mut TrackedFacts) {
+        (&self.actions[id], &mut self.facts)
     }
 
     fn by_content(

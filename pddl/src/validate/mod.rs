@@ -67,7 +67,7 @@ pub fn validate_with(
 ) -> Validation {
     let timed = !plan.steps.is_empty() && plan.steps.iter().all(|s| s.time.is_some());
     if timed {
-        return timed::validate_timed(world, domain, problem, plan, steps, epsilon);
+        return timed::validate_timed(replay, world, domain, problem, plan, steps, epsilon);
     }
     let mut diags = Vec::new();
     if let Some(a) = domain.actions.iter().find(|a| a.durative) {

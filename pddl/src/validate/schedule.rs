@@ -181,5 +181,14 @@ fn valid(
             args: steps[i].1.clone(),
         })
         .collect();
-    validate_timed(world, domain, problem, &plan, &ground, epsilon).valid
+    validate_timed(
+        super::Replay::Cached,
+        world,
+        domain,
+        problem,
+        &plan,
+        &ground,
+        epsilon,
+    )
+    .valid
 }

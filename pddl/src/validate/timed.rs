@@ -5,10 +5,17 @@
 //! then every event's effects apply. A durative action's `over all`
 //! condition must hold in every state strictly inside its interval; its
 //! stated duration must be one its `:duration` allows.
+//!
+//! As the sequential replay, [`Replay::Cached`] tests and sets a step's
+//! ground atoms in [`TrackedFacts`] where that is exact (see [`super::ground`]),
+//! and the general path evaluates the rest in a state flushed first. A
+//! happening of several events takes the general path: what its events
+//! read and write is worked out from the state.
 
+use super::ground::{GroundActions, GroundConds, GroundEffects};
 use super::interference::Footprint;
 use super::step::{Actions, Step};
-use super::{finish, show_step, Validation};
+use super::{finish, show_step, Replay, Validation};
 use crate::ast::{Domain, Formula, Problem};
 use crate::diagnostic::{codes, Diagnostic};
 use crate::logic;
@@ -42,6 +49,8 @@ struct Event {
 /// A durative action that has started and not yet ended.
 struct Running {
     step: usize,
+    /// Its ground action's id in the replay's [`GroundActions`].
+    ground: Option<usize>,
     start: f64,
     end: f64,
     duration: f64,
@@ -52,6 +61,7 @@ struct Running {
 /// form one happening, as in VAL: a plan must separate dependent events
 /// by more than that (IPC plans use `epsilon` itself).
 pub(super) fn validate_timed(
+    replay: Replay,
     world: &World,
     domain: &Domain,
     problem: &Problem,
@@ -59,6 +69,9 @@ pub(super) fn validate_timed(
     steps: &[GroundStep],
     epsilon: f64,
 ) -> Validation {
+    // Derived atoms are recomputed from all facts after every change,
+    // which needs the facts in the state at each event.
+    let cached = replay == Replay::Cached && world.model().derived.is_empty();
     let mut replay = TimedReplay {
         world,
         plan,
@@ -72,7 +85,12 @@ pub(super) fn validate_timed(
         binding: Vec::new(),
         events: Vec::new(),
     };
-    match replay.run() {
+    let mut ground = cached.then(GroundActions::default);
+    let ran = replay.run(ground.as_mut());
+    if let Some(g) = &mut ground {
+        g.facts.flush(&mut replay.state);
+    }
+    match ran {
         Ok(()) => finish(world, problem, plan, replay.state, steps.len(), Vec::new()),
         Err(d) => {
             let cost = super::cost(world, &replay.state, replay.started);
@@ -111,11 +129,15 @@ struct Ready<'a> {
     /// What it reads and writes, worked out only when the happening has
     /// other events it could interfere with (a long sequential plan has
     /// one event per happening).
-    footprint: Option<Footprint>,
+    footprint: Option<Box<Footprint>>,
+    /// Its ground action's id in the replay's [`GroundActions`].
+    ground: Option<usize>,
 }
 
 impl<'a> TimedReplay<'a> {
-    fn run(&mut self) -> Result<(), Diagnostic> {
+    /// Replays every happening; with `ground`, the state's facts may lag
+    /// behind its tracked atoms (flush it before reading them).
+    fn run(&mut self, mut ground: Option<&mut GroundActions<'a>>) -> Result<(), Diagnostic> {
         loop {
             let next_start = self.steps.get(self.started).map(|g| self.time_of(g));
             let next_end = self.running.iter().map(|r| r.end).reduce(f64::min);
@@ -126,7 +148,7 @@ impl<'a> TimedReplay<'a> {
             };
             let before = self.started;
             let happening = self.happening(now);
-            if let Err(d) = self.apply_happening(now, happening) {
+            if let Err(d) = self.apply_happening(now, happening, ground.as_deref_mut()) {
                 // The steps of the failing happening did not apply.
                 self.started = before;
                 return Err(d);
@@ -174,10 +196,19 @@ impl<'a> TimedReplay<'a> {
         events
     }
 
-    fn apply_happening(&mut self, now: f64, mut events: Vec<Event>) -> Result<(), Diagnostic> {
+    fn apply_happening(
+        &mut self,
+        now: f64,
+        mut events: Vec<Event>,
+        mut ground: Option<&mut GroundActions<'a>>,
+    ) -> Result<(), Diagnostic> {
         let world = self.world;
         let mut ready = Vec::with_capacity(events.len());
         let concurrent = events.len() > 1;
+        if let (true, Some(g)) = (concurrent, ground.as_deref_mut()) {
+            // The events' footprints are read from the state.
+            g.facts.flush(&mut self.state);
+        }
         for mut event in events.drain(..) {
             let g = &self.steps[event.step];
             let action = self.actions.get(g.action)?;
@@ -193,33 +224,45 @@ impl<'a> TimedReplay<'a> {
             };
             let footprint = concurrent.then(|| {
                 let mut b = g.args.to_vec();
-                Footprint::of(world, &self.state, conds, effects, &mut b, duration)
+                Box::new(Footprint::of(
+                    world,
+                    &self.state,
+                    conds,
+                    effects,
+                    &mut b,
+                    duration,
+                ))
             });
+            let ground = ground
+                .as_deref_mut()
+                .map(|gr| gr.id(g.action, c, &g.args, &self.state));
             ready.push(Ready {
                 event,
                 action,
                 duration,
                 footprint,
+                ground,
             });
         }
         self.events = events;
         self.check_interference(now, &ready)?;
         for r in &ready {
-            self.check_conditions(r)?;
+            self.check_conditions(r, ground.as_deref_mut())?;
         }
         for r in &ready {
-            self.apply_effects(r)?;
+            self.apply_effects(r, ground.as_deref_mut())?;
             if r.event.phase == Phase::Start {
                 let duration = r.duration.unwrap_or(0.0);
                 self.running.push(Running {
                     step: r.event.step,
+                    ground: r.ground,
                     start: r.event.time,
                     end: r.event.time + duration,
                     duration,
                 });
             }
         }
-        self.check_invariants(now, &ready)
+        self.check_invariants(now, &ready, ground)
     }
 
     /// A starting durative action's duration: the plan's, checked against
@@ -310,7 +353,25 @@ impl<'a> TimedReplay<'a> {
         Ok(())
     }
 
-    fn check_conditions(&mut self, r: &Ready) -> Result<(), Diagnostic> {
+    fn check_conditions(
+        &mut self,
+        r: &Ready,
+        ground: Option<&mut GroundActions<'a>>,
+    ) -> Result<(), Diagnostic> {
+        if let (Some(ground), Some(id)) = (ground, r.ground) {
+            let (ga, facts) = ground.parts(id);
+            let literals = match r.event.phase {
+                Phase::Start | Phase::Instant => &ga.pre_start,
+                Phase::End => &ga.pre_end,
+            };
+            if let GroundConds::Literals(l) = literals {
+                if facts.all_hold(l) {
+                    return Ok(());
+                }
+            }
+            // The general path says why not (or finds that it holds).
+            facts.flush(&mut self.state);
+        }
         let (c, a) = (&*r.action.compiled, r.action.ast);
         let (conds, written, what): (&[Cond], &[Formula], &str) = match r.event.phase {
             Phase::Start => (&c.pre_start, &a.pre_start, "its `at start` condition"),
@@ -335,18 +396,48 @@ impl<'a> TimedReplay<'a> {
         Ok(())
     }
 
-    fn apply_effects(&mut self, r: &Ready) -> Result<(), Diagnostic> {
+    fn apply_effects(
+        &mut self,
+        r: &Ready,
+        ground: Option<&mut GroundActions<'a>>,
+    ) -> Result<(), Diagnostic> {
         let c = &*r.action.compiled;
-        let effects = match r.event.phase {
-            Phase::Start => &c.eff_start,
-            Phase::End | Phase::Instant => &c.eff_end,
-        };
+        let start = r.event.phase == Phase::Start;
+        let mut effects: &[Eff] = if start { &c.eff_start } else { &c.eff_end };
+        let mut tracked = None;
+        if let (Some(ground), Some(id)) = (ground, r.ground) {
+            let (ga, facts) = ground.parts(id);
+            match if start { &ga.eff_start } else { &ga.eff_end } {
+                GroundEffects::Cached {
+                    delete,
+                    add,
+                    numeric,
+                } => {
+                    // Numeric updates read fluents only, which the
+                    // table never holds back: evaluated here, applied
+                    // with the atoms.
+                    facts.set(delete, false);
+                    facts.set(add, true);
+                    if numeric.is_empty() {
+                        return Ok(());
+                    }
+                    effects = numeric;
+                }
+                GroundEffects::General => {
+                    facts.flush(&mut self.state);
+                    tracked = Some(facts);
+                }
+            }
+        }
         let mut b = self.binding_of(r.event.step);
         for e in effects {
             self.world
                 .collect(&self.state, e, &mut b, r.duration, &mut self.changes);
         }
         self.binding = b;
+        if let Some(facts) = tracked {
+            facts.note(&self.changes);
+        }
         if let Some(err) = self.changes.numeric_errors.first() {
             let d = self
                 .error(
@@ -367,14 +458,29 @@ impl<'a> TimedReplay<'a> {
 
     /// Every running action's `over all` condition, in the state after
     /// this happening (strictly inside its interval).
-    fn check_invariants(&mut self, now: f64, ready: &[Ready]) -> Result<(), Diagnostic> {
+    fn check_invariants(
+        &mut self,
+        now: f64,
+        ready: &[Ready],
+        mut ground: Option<&mut GroundActions<'a>>,
+    ) -> Result<(), Diagnostic> {
         let world = self.world;
+        let steps = self.steps;
         for r in &self.running {
-            let g = &self.steps[r.step];
+            let g = &steps[r.step];
             let action = self.actions.get(g.action)?;
             let (c, a) = (&*action.compiled, action.ast);
             if c.pre_over_all.is_empty() {
                 continue;
+            }
+            if let (Some(ground), Some(id)) = (ground.as_deref_mut(), r.ground) {
+                let (ga, facts) = ground.parts(id);
+                if let GroundConds::Literals(l) = &ga.pre_over_all {
+                    if facts.all_hold(l) {
+                        continue;
+                    }
+                }
+                facts.flush(&mut self.state);
             }
             let mut b = g.args.to_vec();
             for (cond, f) in c.pre_over_all.iter().zip(&a.pre_over_all) {
