@@ -440,15 +440,19 @@ impl StepCounts {
 /// output must wait for the verdict: `--check`, standard output, `--emit
 /// kb`, a folder still to be created (a refused job creates nothing), a
 /// target not replaced atomically, a job that does not lower or that a
-/// py_trees module cannot express (the usual way then reports why).
+/// py_trees module cannot express (the usual way then reports why). Where
+/// the output waits, the tree is still lowered meanwhile, memoized for
+/// that way, as [`load_job`] does.
 fn emit_meanwhile(db: &Database, job: db::CompileJob, a: &CompileArgs) -> Option<Made> {
     let (Output::Tree(format), Some(out), false) = (a.emit, a.output.as_deref(), a.check) else {
+        let _ = db::compile(db, job);
         return None;
     };
     if !out
         .parent()
         .is_none_or(|d| d.as_os_str().is_empty() || d.is_dir())
     {
+        let _ = db::compile(db, job);
         return None;
     }
     let mut ir = db::lower_job(db, job).ok()?;
