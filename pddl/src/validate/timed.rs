@@ -7,10 +7,10 @@
 //! stated duration must be one its `:duration` allows.
 //!
 //! As the sequential replay, [`Replay::Cached`] tests and sets a step's
-//! ground atoms in [`TrackedFacts`] where that is exact (see [`super::ground`]),
+//! ground atoms in a table where that is exact (see [`super::ground`]),
 //! and the general path evaluates the rest in a state flushed first. A
-//! happening of several events takes the general path: what its events
-//! read and write is worked out from the state.
+//! happening of several events is flushed before it starts: what its
+//! events read and write is worked out from the state.
 
 use super::ground::{GroundActions, GroundConds, GroundEffects};
 use super::interference::Footprint;
