@@ -235,3 +235,28 @@ fn a_shared_stream_is_a_writer() {
     s.finish().unwrap();
     assert_eq!(std::fs::read(&p).unwrap(), b"one\ntwo\n");
 }
+
+/// A regular file is replaced, not overwritten: a reader that opened the
+/// old file (an executor loading the last tree) reads it whole, and the
+/// folder holds the new file alone.
+#[test]
+fn a_reader_of_the_old_file_keeps_reading_it_whole() {
+    use std::io::Read;
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("tree.xml");
+    std::fs::write(&p, b"old tree").unwrap();
+    let mut reader = std::fs::File::open(&p).unwrap();
+    let staged = stage(&p, &mut |w| w.write_all(b"new tree, longer"))
+        .unwrap()
+        .unwrap();
+    staged.commit().unwrap();
+    let mut old = String::new();
+    reader.read_to_string(&mut old).unwrap();
+    assert_eq!(old, "old tree");
+    assert_eq!(std::fs::read(&p).unwrap(), b"new tree, longer");
+    let names: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(names, ["tree.xml"]);
+}
