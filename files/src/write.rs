@@ -173,30 +173,11 @@ pub fn stage(path: &Path, produce: &mut Produce<'_>) -> io::Result<Option<Staged
 /// support) is an error, and the caller renames.
 #[cfg(target_os = "linux")]
 fn exchange(new: &Path, target: &Path) -> io::Result<()> {
-    use std::os::unix::ffi::OsStrExt;
+    use rustix::fs::{renameat_with, RenameFlags, CWD};
     if !std::fs::symlink_metadata(target)?.is_file() {
         return Err(io::Error::other("not a regular file"));
     }
-    let c = |p: &Path| {
-        std::ffi::CString::new(p.as_os_str().as_bytes())
-            .map_err(|_| io::Error::other("NUL in a path"))
-    };
-    let (from, to) = (c(new)?, c(target)?);
-    // SAFETY: both are NUL-terminated paths that outlive the call.
-    let r = unsafe {
-        libc::renameat2(
-            libc::AT_FDCWD,
-            from.as_ptr(),
-            libc::AT_FDCWD,
-            to.as_ptr(),
-            libc::RENAME_EXCHANGE,
-        )
-    };
-    if r == 0 {
-        Ok(())
-    } else {
-        Err(io::Error::last_os_error())
-    }
+    Ok(renameat_with(CWD, new, CWD, target, RenameFlags::EXCHANGE)?)
 }
 
 #[cfg(not(target_os = "linux"))]
