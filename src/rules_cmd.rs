@@ -444,17 +444,17 @@ impl StepCounts {
 /// the output waits, the tree is still lowered meanwhile, memoized for
 /// that way, as [`load_job`] does.
 fn emit_meanwhile(db: &Database, job: db::CompileJob, a: &CompileArgs) -> Option<Made> {
-    let (Output::Tree(format), Some(out), false) = (a.emit, a.output.as_deref(), a.check) else {
-        let _ = db::compile(db, job);
-        return None;
+    let folder_is_there = |out: &Path| {
+        out.parent()
+            .is_none_or(|d| d.as_os_str().is_empty() || d.is_dir())
     };
-    if !out
-        .parent()
-        .is_none_or(|d| d.as_os_str().is_empty() || d.is_dir())
-    {
-        let _ = db::compile(db, job);
-        return None;
-    }
+    let (format, out) = match (a.emit, a.output.as_deref(), a.check) {
+        (Output::Tree(format), Some(out), false) if folder_is_there(out) => (format, out),
+        _ => {
+            let _ = db::compile(db, job);
+            return None;
+        }
+    };
     let mut ir = db::lower_job(db, job).ok()?;
     if format == emit::Format::Pytrees
         && !targets::refusals(db, job, &ir, targets::Target::Pytrees).is_empty()
