@@ -25,6 +25,14 @@ struct CallParts {
     lowered: Option<Lowered>,
 }
 
+/// What [`Steps::call`] finds for a step.
+enum Call {
+    /// The step repeats a ground action lowered before.
+    Repeated(Lowered),
+    /// The step's logic, its rule still to be found.
+    New(StepLogic),
+}
+
 /// A step's call: its action and the address of its shared argument list.
 type CallKey = (usize, *const u32);
 
@@ -105,9 +113,10 @@ impl<'i> Steps<'i> {
         }
     }
 
-    /// The parts of step `g`'s call: its names, ground logic and, when a
-    /// step before it had the same ground action, how that one lowered.
-    fn call(&mut self, g: &'i GroundStep) -> (Option<Lowered>, StepLogic) {
+    /// How step `g`'s call lowered when a step before it had the same
+    /// ground action; else its names and ground logic, to lower it now.
+    /// A repeat costs one lookup and the two shares its step keeps.
+    fn call(&mut self, g: &'i GroundStep) -> Call {
         let input = self.input;
         let action = &input.domain.actions[g.action];
         let parts = self.calls.entry(call_key(g)).or_insert_with(|| CallParts {
@@ -131,8 +140,11 @@ impl<'i> Steps<'i> {
                 .ground(input.domain, g.action, &g.args, &self.object_names),
             lowered: self.lowered.get(&(g.action, &g.args[..])).cloned(),
         });
+        if let Some(done) = &parts.lowered {
+            return Call::Repeated(done.clone());
+        }
         let ground = parts.ground.clone();
-        let logic = StepLogic {
+        Call::New(StepLogic {
             action: parts.action.clone(),
             args: parts.args.clone(),
             rule: None,
@@ -141,8 +153,7 @@ impl<'i> Steps<'i> {
             pre_end: ground.pre_end,
             eff_start: ground.eff_start,
             eff_end: ground.eff_end,
-        };
-        (parts.lowered.clone(), logic)
+        })
     }
 
     /// Lowers step `k` (`g`); a problem is a diagnostic at its plan line.
@@ -159,13 +170,15 @@ impl<'i> Steps<'i> {
             after: Default::default(),
             logic,
         };
-        let (repeated, mut logic) = self.call(g);
-        if let Some(r) = repeated {
-            self.infos.push(place(r.logic.rule.is_none(), r.logic));
-            self.step_nodes
-                .push(r.child.map(|child| Node::Step { step: k, child }));
-            return;
-        }
+        let mut logic = match self.call(g) {
+            Call::New(logic) => logic,
+            Call::Repeated(r) => {
+                self.infos.push(place(r.logic.rule.is_none(), r.logic));
+                self.step_nodes
+                    .push(r.child.map(|child| Node::Step { step: k, child }));
+                return;
+            }
+        };
         let diags_before = self.diags.len();
         let args = logic.args.clone();
         let tables = |name: &str| input.decls.tables.get(name).cloned();
