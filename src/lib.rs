@@ -3,6 +3,7 @@
 //! binary (`main.rs`) and the Python package's `btc` command both run
 //! [`run`].
 
+pub mod alloc;
 mod domain_lookup;
 mod executor_cmd;
 mod files;

@@ -257,6 +257,7 @@ pub fn record_paths_from(ir: &mut btc_ir::TreeIr, base: &Path) {
 }
 
 pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
+    expect_buffers_for(&a.plan);
     let (mut job, made) = load_job_then(
         &a.rules,
         PlanSource::File(FilePath::new(&a.plan)),
@@ -431,6 +432,20 @@ impl StepCounts {
             self.steps,
             self.skipped
         )
+    }
+}
+
+/// A long plan's compile fills about five times the plan's size in large
+/// buffers (its text, steps, typed steps, step records and nodes; six
+/// leaves room): their pages are written in beforehand (`crate::alloc`).
+/// Short plans gain nothing from it.
+fn expect_buffers_for(plan: &Path) {
+    const LONG_PLAN: u64 = 1 << 20;
+    const MOST: u64 = 1 << 30;
+    if let Ok(m) = std::fs::metadata(plan) {
+        if m.len() >= LONG_PLAN {
+            crate::alloc::expect_large((m.len() * 6).min(MOST) as usize);
+        }
     }
 }
 

@@ -332,6 +332,59 @@ fn a_long_plan_streams_to_a_file_and_to_a_reader_that_stops() {
     assert!(!stderr.contains("panicked"), "{stderr}");
 }
 
+/// A long plan's compile serves its large buffers from a region whose
+/// pages a second thread writes in (`btc::alloc`, the binary's allocator
+/// only): the binary's tree is byte for byte the one the same command
+/// makes in this process, where the region is never made.
+#[test]
+fn a_long_compile_is_the_same_with_its_pages_written_in_beforehand() {
+    let dir = tempfile::tempdir().unwrap();
+    let example = Path::new("examples/p3_assembler");
+    let plan = dir.path().join("plan.tplan");
+    std::fs::write(&plan, btc_testkit::long_p3_plan(30_000)).unwrap();
+    assert!(std::fs::metadata(&plan).unwrap().len() > 1 << 20);
+    for (format, file) in [("pytrees", "tree.py"), ("btcpp", "tree.xml")] {
+        let args = |out: &Path| -> Vec<std::ffi::OsString> {
+            let mut args: Vec<std::ffi::OsString> = vec![
+                "compile".into(),
+                example.join("rules.btrules").into(),
+                "--plan".into(),
+                plan.clone().into(),
+                "--problem".into(),
+                example.join("problem.pddl").into(),
+                "--emit".into(),
+                format.into(),
+                "-o".into(),
+            ];
+            args.push(out.into());
+            args
+        };
+        let (by_binary, in_process) =
+            (dir.path().join(file), dir.path().join(format!("in-{file}")));
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_btc"))
+            .args(args(&by_binary))
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let mut argv = vec![std::ffi::OsString::from("btc")];
+        argv.extend(args(&in_process));
+        assert_eq!(btc::run(argv), std::process::ExitCode::SUCCESS);
+        let (a, b) = (
+            std::fs::read(&by_binary).unwrap(),
+            std::fs::read(&in_process).unwrap(),
+        );
+        assert!(a.len() > 1 << 20, "{format}: {} bytes", a.len());
+        assert!(
+            a == b,
+            "{format}: the binary's tree differs from the library's"
+        );
+    }
+}
+
 /// Every command that prints its result ends quietly when its reader has
 /// gone before it writes (`btc plan ... --format json | head -c 10`): the
 /// pipe's read end is closed before btc starts, so every write fails.
