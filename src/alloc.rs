@@ -8,6 +8,14 @@
 //! once, on its critical path, while its second core waits for the plan to
 //! be read. [`expect_large`] hands that wait to the faults instead.
 //!
+//! The helper writes a byte to each page, so that the kernel faults it in
+//! under the region's own lock: asking for the pages (`MADV_POPULATE_WRITE`)
+//! would hold the process's map lock, and every `mmap` of the other threads
+//! (a thread's stack, mimalloc's segments) would wait for it. It writes
+//! only pages no buffer has been served from, one chunk at a time: it
+//! claims the chunk, then checks that no buffer reached it meanwhile; a
+//! buffer that reaches a claimed chunk waits for its writing to end.
+//!
 //! Only allocations of [`LARGE`] bytes or more are served from the region,
 //! by moving a pointer; a freed buffer is given back only when it was the
 //! last one served (a growing vector extends in place), else its space is
@@ -23,25 +31,27 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 /// and freed often, and mimalloc reuses their pages.
 pub const LARGE: usize = 256 << 10;
 
-/// How much the helper writes in at a time: small enough that it stays
-/// just ahead of the allocations, large enough to keep its calls few.
-const CHUNK: usize = 256 << 10;
+/// How much the helper claims at a time: small, as a buffer that reaches
+/// the chunk waits until its pages are in.
+const CHUNK: usize = 128 << 10;
 
 /// mimalloc, with the region in front of it for large allocations.
 pub struct Alloc;
 
-/// The region: `[start, end)`, served up to `next`. `start == 0` while
-/// there is none.
+/// The region: `[start, end)`, served up to `next`; the helper is writing
+/// the chunk at `claimed` (0: none). `start == 0` while there is none.
 struct Region {
     start: AtomicUsize,
     end: AtomicUsize,
     next: AtomicUsize,
+    claimed: AtomicUsize,
 }
 
 static REGION: Region = Region {
     start: AtomicUsize::new(0),
     end: AtomicUsize::new(0),
     next: AtomicUsize::new(0),
+    claimed: AtomicUsize::new(0),
 };
 
 /// Set by the first allocation through [`Alloc`]: the region is worth
@@ -69,9 +79,12 @@ impl Region {
             };
             match self
                 .next
-                .compare_exchange_weak(next, after, Ordering::AcqRel, Ordering::Relaxed)
+                .compare_exchange_weak(next, after, Ordering::SeqCst, Ordering::Relaxed)
             {
-                Ok(_) => return at as *mut u8,
+                Ok(_) => {
+                    self.wait_for_helper(at, after);
+                    return at as *mut u8;
+                }
                 Err(now) => next = now,
             }
         }
@@ -95,9 +108,35 @@ impl Region {
         else {
             return false;
         };
-        self.next
-            .compare_exchange(p + old, after, Ordering::AcqRel, Ordering::Relaxed)
-            .is_ok()
+        let grown = self
+            .next
+            .compare_exchange(p + old, after, Ordering::SeqCst, Ordering::Relaxed)
+            .is_ok();
+        if grown {
+            self.wait_for_helper(p, after);
+        }
+        grown
+    }
+
+    /// Waits while the helper writes a chunk that `[from, to)`, just
+    /// served, reaches. The served end is published (`next`) before the
+    /// claim is read, and the helper publishes its claim before it reads
+    /// `next`: one of the two sees the other.
+    fn wait_for_helper(&self, from: usize, to: usize) {
+        let mut spins = 0u32;
+        loop {
+            let c = self.claimed.load(Ordering::SeqCst);
+            if c == 0 || c >= to || c + CHUNK <= from {
+                return;
+            }
+            spins += 1;
+            if spins < 64 {
+                std::hint::spin_loop();
+            } else {
+                // The helper may have lost its core; give it back.
+                std::thread::yield_now();
+            }
+        }
     }
 }
 
@@ -158,20 +197,26 @@ unsafe impl GlobalAlloc for Alloc {
     }
 }
 
-/// Makes a region of `bytes` for the large buffers to come and has a
-/// second thread write its pages in, front to back, ahead of them. Once
-/// per process; nothing where [`Alloc`] is not the global allocator or the
-/// system refuses the memory (allocations then go to mimalloc as before).
+/// Makes a region for the large buffers to come, about `bytes` of them,
+/// and has a second thread write in that many of its pages, front to back,
+/// ahead of the buffers. The region is twice as large (its address space
+/// only): buffers beyond the estimate still come from it, their pages
+/// faulted in as used. Once per process; nothing where [`Alloc`] is not
+/// the global allocator or the system refuses the memory (allocations
+/// then go to mimalloc as before).
 pub fn expect_large(bytes: usize) {
     static ONCE: std::sync::Once = std::sync::Once::new();
     if !INSTALLED.load(Ordering::Relaxed) || bytes < 2 * CHUNK {
         return;
     }
     ONCE.call_once(|| {
+        let Some(room) = bytes.checked_mul(2) else {
+            return;
+        };
         let Ok(start) = (unsafe {
             rustix::mm::mmap_anonymous(
                 std::ptr::null_mut(),
-                bytes,
+                room,
                 rustix::mm::ProtFlags::READ | rustix::mm::ProtFlags::WRITE,
                 rustix::mm::MapFlags::PRIVATE | rustix::mm::MapFlags::NORESERVE,
             )
@@ -180,7 +225,7 @@ pub fn expect_large(bytes: usize) {
         };
         let start = start as usize;
         REGION.next.store(start, Ordering::Relaxed);
-        REGION.end.store(start + bytes, Ordering::Relaxed);
+        REGION.end.store(start + room, Ordering::Relaxed);
         REGION.start.store(start, Ordering::Release);
         let _ = std::thread::Builder::new()
             .name("btc-pages".into())
@@ -189,25 +234,30 @@ pub fn expect_large(bytes: usize) {
 }
 
 /// Writes the pages of `[start, end)` in, a chunk at a time, from the
-/// first not yet served: a page a thread has touched already is left as
-/// it is (the kernel writes in only missing pages, never data).
+/// first page no buffer has been served from.
 fn write_in(start: usize, end: usize) {
+    let page = rustix::param::page_size();
     let mut front = start;
-    while front < end {
-        let page = rustix::param::page_size();
-        front = front.max(REGION.next.load(Ordering::Relaxed) / page * page);
-        let to = (front + CHUNK).min(end);
-        let advised = unsafe {
-            rustix::mm::madvise(
-                front as *mut std::ffi::c_void,
-                to - front,
-                rustix::mm::Advice::LinuxPopulateWrite,
-            )
-        };
-        if advised.is_err() {
-            // A kernel before 5.14: the pages are faulted in as used.
+    loop {
+        let served = REGION.next.load(Ordering::SeqCst);
+        let from = front.max(served.next_multiple_of(page));
+        if from >= end {
             return;
         }
+        let to = (from + CHUNK).min(end);
+        REGION.claimed.store(from, Ordering::SeqCst);
+        if REGION.next.load(Ordering::SeqCst) > from {
+            // A buffer reached the chunk first: start again after it.
+            REGION.claimed.store(0, Ordering::SeqCst);
+            continue;
+        }
+        for p in (from..to).step_by(page) {
+            // Safety: the page is in the region, and no buffer has been
+            // served from it (any that reaches it waits for the claim to
+            // end), so no one else reads or writes it now.
+            unsafe { std::ptr::write_volatile(p as *mut u8, 0) };
+        }
+        REGION.claimed.store(0, Ordering::Release);
         front = to;
     }
 }
@@ -283,6 +333,32 @@ mod tests {
             assert!(REGION.contains(zeroed));
             assert!((0..LARGE).all(|i| *zeroed.add(i) == 0));
             a.dealloc(small, layout(1024));
+        }
+        // Meanwhile: buffers served while the helper writes pages in keep
+        // every byte written to them.
+        let size = 64 << 20;
+        let start = region_over(size);
+        let helper = std::thread::spawn(move || write_in(start, start + size));
+        let mut buffers = Vec::new();
+        for k in 0..120usize {
+            let len = LARGE + (k * 7919) % (3 * LARGE);
+            unsafe {
+                let mut p = a.alloc(layout(len));
+                std::ptr::write_bytes(p, 1 + (k % 250) as u8, len);
+                if k % 3 == 0 {
+                    // The last buffer grows in place, into pages not yet in.
+                    p = a.realloc(p, layout(len), 2 * len);
+                    std::ptr::write_bytes(p.add(len), 1 + (k % 250) as u8, len);
+                    buffers.push((p, 2 * len, k));
+                } else {
+                    buffers.push((p, len, k));
+                }
+            }
+        }
+        helper.join().unwrap();
+        for &(p, len, k) in &buffers {
+            let kept = unsafe { std::slice::from_raw_parts(p, len) };
+            assert!(kept.iter().all(|&b| b == 1 + (k % 250) as u8), "buffer {k}");
         }
     }
 }

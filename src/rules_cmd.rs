@@ -436,15 +436,15 @@ impl StepCounts {
 }
 
 /// A long plan's compile fills about five times the plan's size in large
-/// buffers (its text, steps, typed steps, step records and nodes; six
-/// leaves room): their pages are written in beforehand (`crate::alloc`).
-/// Short plans gain nothing from it.
+/// buffers (its text, steps, typed steps, step records and nodes): their
+/// pages are written in beforehand (`crate::alloc`). Short plans gain
+/// nothing from it.
 fn expect_buffers_for(plan: &Path) {
     const LONG_PLAN: u64 = 1 << 20;
     const MOST: u64 = 1 << 30;
     if let Ok(m) = std::fs::metadata(plan) {
         if m.len() >= LONG_PLAN {
-            crate::alloc::expect_large((m.len() * 6).min(MOST) as usize);
+            crate::alloc::expect_large((m.len() * 5).min(MOST) as usize);
         }
     }
 }
