@@ -84,6 +84,7 @@ pub(super) fn validate_timed(
         changes: Changes::default(),
         binding: Vec::new(),
         events: Vec::new(),
+        ready: Vec::new(),
     };
     let mut ground = cached.then(GroundActions::default);
     let ran = replay.run(ground.as_mut());
@@ -116,9 +117,12 @@ struct TimedReplay<'a> {
     epsilon: f64,
     changes: Changes,
     /// Buffers reused from event to event (a long plan has hundreds of
-    /// thousands): a step's arguments as a binding, a happening's events.
+    /// thousands): a step's arguments as a binding, a happening's events
+    /// and what they need (a buffer made for each happening cost a cache
+    /// miss at its first write).
     binding: Vec<u32>,
     events: Vec<Event>,
+    ready: Vec<Ready<'a>>,
 }
 
 /// An event with what it needs at its happening.
@@ -203,7 +207,8 @@ impl<'a> TimedReplay<'a> {
         mut ground: Option<&mut GroundActions<'a>>,
     ) -> Result<(), Diagnostic> {
         let world = self.world;
-        let mut ready = Vec::with_capacity(events.len());
+        let mut ready = std::mem::take(&mut self.ready);
+        ready.clear();
         let concurrent = events.len() > 1;
         if let (true, Some(g)) = (concurrent, ground.as_deref_mut()) {
             // The events' footprints are read from the state.
@@ -262,7 +267,10 @@ impl<'a> TimedReplay<'a> {
                 });
             }
         }
-        self.check_invariants(now, &ready, ground)
+        let checked = self.check_invariants(now, &ready, ground);
+        ready.clear();
+        self.ready = ready;
+        checked
     }
 
     /// A starting durative action's duration: the plan's, checked against
