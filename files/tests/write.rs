@@ -48,6 +48,41 @@ fn a_produced_output_lands_whole() {
     assert!(leftovers(dir.path()).is_empty());
 }
 
+/// A long old file's length is allocated ahead for the new output: one
+/// shorter or longer than it ends where its bytes end, without the old
+/// file's blocks past them, and one that fails leaves the old file.
+#[test]
+fn an_output_replacing_a_long_file_ends_where_it_ends() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("tree.py");
+    std::fs::write(&p, vec![b'x'; 3 << 20]).unwrap();
+    for (len, byte) in [
+        (2 << 20, b'a'),
+        (3 << 20, b'b'),
+        (5 << 20, b'c'),
+        (1000, b'd'),
+    ] {
+        write_with(&p, &mut |w| w.write_all(&vec![byte; len])).unwrap();
+        let got = std::fs::read(&p).unwrap();
+        assert_eq!(got.len(), len);
+        assert!(got.iter().all(|&b| b == byte));
+        let allocated = std::fs::metadata(&p).unwrap().blocks() * 512;
+        assert!(
+            allocated < len as u64 + (64 << 10),
+            "{allocated} bytes of blocks for {len}"
+        );
+        assert!(leftovers(dir.path()).is_empty());
+    }
+    std::fs::write(&p, vec![b'x'; 3 << 20]).unwrap();
+    let failed = write_with(&p, &mut |w| {
+        w.write_all(&[b'y'; 1 << 20])?;
+        Err(std::io::Error::other("disk full"))
+    });
+    assert!(failed.is_err());
+    assert_eq!(std::fs::read(&p).unwrap(), vec![b'x'; 3 << 20]);
+    assert!(leftovers(dir.path()).is_empty());
+}
+
 /// A producer that fails half-way (a full disk, a broken emitter) leaves
 /// the old file as it was, and no temporary file beside it.
 #[test]
