@@ -44,6 +44,8 @@ struct Event {
     time: f64,
     /// An end's duration (its action's, known since its start).
     duration: Option<f64>,
+    /// An end's ground action id, found at its start.
+    ground: Option<usize>,
 }
 
 /// A durative action that has started and not yet ended.
@@ -179,6 +181,7 @@ impl<'a> TimedReplay<'a> {
                     phase: Phase::End,
                     time: r.end,
                     duration: Some(r.duration),
+                    ground: r.ground,
                 });
             } else {
                 i += 1;
@@ -194,6 +197,7 @@ impl<'a> TimedReplay<'a> {
                 phase: Phase::Instant, // a durative action's start: set from the action
                 time,
                 duration: None,
+                ground: None,
             });
             self.started += 1;
         }
@@ -238,9 +242,10 @@ impl<'a> TimedReplay<'a> {
                     duration,
                 ))
             });
-            let ground = ground
-                .as_deref_mut()
-                .map(|gr| gr.id(g.action, c, &g.args, &self.state));
+            let ground = match (event.ground, ground.as_deref_mut()) {
+                (Some(id), _) => Some(id),
+                (None, grounds) => grounds.map(|gr| gr.id(g.action, c, &g.args, &self.state)),
+            };
             ready.push(Ready {
                 event,
                 action,
@@ -518,6 +523,7 @@ impl<'a> TimedReplay<'a> {
                     phase: Phase::Start,
                     time: r.start,
                     duration: Some(r.duration),
+                    ground: r.ground,
                 };
                 return Err(self
                     .error(
