@@ -158,8 +158,7 @@ unsafe impl GlobalAlloc for Alloc {
         if layout.size() >= LARGE {
             let p = REGION.take(layout);
             if !p.is_null() {
-                // Pages of the region are fresh (zero) or were served and
-                // given back: only those need clearing.
+                // Space given back may hold a freed buffer's bytes.
                 unsafe { std::ptr::write_bytes(p, 0, layout.size()) };
                 return p;
             }

@@ -211,8 +211,8 @@ impl<'a> TimedReplay<'a> {
         mut ground: Option<&mut GroundActions<'a>>,
     ) -> Result<(), Diagnostic> {
         let world = self.world;
+        // Left empty by the happening before (or by none).
         let mut ready = std::mem::take(&mut self.ready);
-        ready.clear();
         let concurrent = events.len() > 1;
         if let (true, Some(g)) = (concurrent, ground.as_deref_mut()) {
             // The events' footprints are read from the state.
@@ -242,10 +242,11 @@ impl<'a> TimedReplay<'a> {
                     duration,
                 ))
             });
-            let ground = match (event.ground, ground.as_deref_mut()) {
-                (Some(id), _) => Some(id),
-                (None, grounds) => grounds.map(|gr| gr.id(g.action, c, &g.args, &self.state)),
-            };
+            let ground = event.ground.or_else(|| {
+                ground
+                    .as_deref_mut()
+                    .map(|gr| gr.id(g.action, c, &g.args, &self.state))
+            });
             ready.push(Ready {
                 event,
                 action,
