@@ -71,14 +71,16 @@ fn read_plan(text: &str, file: FileId, quick: bool) -> (Plan, Vec<Diagnostic>) {
             file,
             line: i as u32 + 1,
         };
-        let read = match quick
-            .then(|| quick::step(line, place, &mut calls))
+        if let Some(format) = quick
+            .then(|| quick::step(line, place, &mut calls, &mut plan.steps))
             .flatten()
         {
-            Some(l) => Ok(l),
-            None => LineReader::new(line, place).read(&mut in_ff),
-        };
-        match read {
+            if plan.format == PlanFormat::Empty {
+                plan.format = format;
+            }
+            continue;
+        }
+        match LineReader::new(line, place).read(&mut in_ff) {
             Ok(Line::Blank) => {}
             Ok(Line::Comment) => {
                 if let Some(c) = stated_cost(line, line_start, file) {
@@ -97,12 +99,15 @@ fn read_plan(text: &str, file: FileId, quick: bool) -> (Plan, Vec<Diagnostic>) {
     if plan.steps.is_empty() && diags.is_empty() {
         diags.push(no_steps(file));
     }
-    if plan.steps.iter().any(|s| s.time.is_some()) {
-        // Temporal planners do not always print in time order (LPG).
-        plan.steps.sort_by(|a, b| {
-            let (x, y) = (a.time.unwrap_or(0.0), b.time.unwrap_or(0.0));
-            x.total_cmp(&y)
-        });
+    // Temporal planners do not always print in time order (LPG). A stable
+    // sort takes a buffer the size of the steps before it looks at them:
+    // most plans are in order already, and need none.
+    let time = |s: &PlanStep| s.time.unwrap_or(0.0);
+    if !plan
+        .steps
+        .is_sorted_by(|a, b| time(a).total_cmp(&time(b)).is_le())
+    {
+        plan.steps.sort_by(|a, b| time(a).total_cmp(&time(b)));
     }
     (plan, diags)
 }
@@ -681,7 +686,7 @@ mod tests {
             "0:\t(load r h c1)\t[2]",
         ] {
             assert!(
-                quick::step(line, at, &mut quick::Calls::default()).is_some(),
+                quick::step(line, at, &mut quick::Calls::default(), &mut Vec::new()).is_some(),
                 "{line}"
             );
         }
