@@ -477,10 +477,13 @@ fn emit_meanwhile(db: &Database, job: db::CompileJob, a: &CompileArgs) -> Option
         return None;
     }
     record_paths_from(&mut ir, output_folder(a));
+    // Counted while the steps just lowered are in the cache, not after the
+    // output has been through it.
+    let counts = StepCounts::of(&ir);
     let staged = btc_files::stage(out, &mut |w| emit::emit_to(&ir, format, &a.options, w));
     let made = Made {
         staged: staged.ok()??,
-        counts: StepCounts::of(&ir),
+        counts,
     };
     // The process ends soon: the OS reclaims the IR at once.
     std::mem::forget(ir);
