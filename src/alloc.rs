@@ -16,14 +16,6 @@
 //! claims the chunk, then checks that no buffer reached it meanwhile; a
 //! buffer that reaches a claimed chunk waits for its writing to end.
 //!
-//! Where the kernel has free huge pages to spare, the region asks for
-//! them (transparent huge pages, `MADV_HUGEPAGE`): one fault then brings
-//! in 2 MB, zeroed in a sixth of the time 512 small faults take on this
-//! VM, and the process's exit frees a few pages instead of thousands. The
-//! advice is given only when the free lists hold twice the huge pages the
-//! region needs, as a huge page the kernel must first make by compacting
-//! memory can stall a fault far longer than the faults it saves.
-//!
 //! Only allocations of [`LARGE`] bytes or more are served from the region,
 //! by moving a pointer; a freed buffer is given back only when it was the
 //! last one served (a growing vector extends in place), else its space is
@@ -220,33 +212,17 @@ pub fn expect_large(bytes: usize) {
         let Some(room) = bytes.checked_mul(2) else {
             return;
         };
-        let huge = huge_pages_free(&std::fs::read_to_string(BUDDY_INFO).unwrap_or_default())
-            >= 2 * bytes.div_ceil(HUGE_PAGE);
-        // Room to start on a huge page's boundary.
-        let mapped = room + if huge { HUGE_PAGE } else { 0 };
-        let Ok(at) = (unsafe {
+        let Ok(start) = (unsafe {
             rustix::mm::mmap_anonymous(
                 std::ptr::null_mut(),
-                mapped,
+                room,
                 rustix::mm::ProtFlags::READ | rustix::mm::ProtFlags::WRITE,
                 rustix::mm::MapFlags::PRIVATE | rustix::mm::MapFlags::NORESERVE,
             )
         }) else {
             return;
         };
-        let mut start = at as usize;
-        if huge {
-            start = start.next_multiple_of(HUGE_PAGE);
-            // Only advice: without it (or where the kernel has no huge
-            // pages) the region is served the same, in small pages.
-            let _ = unsafe {
-                rustix::mm::madvise(
-                    start as *mut std::ffi::c_void,
-                    room,
-                    rustix::mm::Advice::LinuxHugepage,
-                )
-            };
-        }
+        let start = start as usize;
         REGION.next.store(start, Ordering::Relaxed);
         REGION.end.store(start + room, Ordering::Relaxed);
         REGION.start.store(start, Ordering::Release);
@@ -254,33 +230,6 @@ pub fn expect_large(bytes: usize) {
             .name("btc-pages".into())
             .spawn(move || write_in(start, start + bytes));
     });
-}
-
-/// A transparent huge page on x86-64 and most of Linux's other targets.
-const HUGE_PAGE: usize = 2 << 20;
-
-/// The kernel's free lists: how many free blocks of each order (a block
-/// of order k is 2^k pages) each zone has.
-const BUDDY_INFO: &str = "/proc/buddyinfo";
-
-/// How many free huge pages `/proc/buddyinfo` lists: blocks of order 9
-/// (2 MB of 4 KiB pages) and up, counted in 2 MB. With that many free, a
-/// huge page is taken off a free list at once; without, the kernel would
-/// compact memory to make one, and a fault could stall for milliseconds
-/// to hundreds of them (huge pages are asked for only when this is ample).
-fn huge_pages_free(buddy_info: &str) -> usize {
-    const HUGE_ORDER: usize = 9;
-    buddy_info
-        .lines()
-        .flat_map(|zone| {
-            // "Node 0, zone   Normal   n0 n1 ... n10"
-            zone.split_whitespace()
-                .skip(4)
-                .enumerate()
-                .skip(HUGE_ORDER)
-                .map(|(order, n)| n.parse::<usize>().unwrap_or(0) << (order - HUGE_ORDER))
-        })
-        .sum()
 }
 
 /// Writes the pages of `[start, end)` in, a chunk at a time, from the
@@ -336,18 +285,6 @@ mod tests {
         Layout::from_size_align(size, 64).unwrap()
     }
 
-    #[test]
-    fn huge_pages_are_counted_from_the_free_lists() {
-        // Orders 9 and 10 of each zone: 1 + 2·3, 1 + 2·753, 26 + 2·66.
-        let free = include_str!("../tests/fixtures/alloc/buddyinfo.txt");
-        assert_eq!(huge_pages_free(free), 7 + 1507 + 158);
-        // Memory in small pieces: eight huge pages free, seven of them in
-        // the small DMA zone; too few for a long plan's region.
-        let fragmented = include_str!("../tests/fixtures/alloc/buddyinfo_fragmented.txt");
-        assert_eq!(huge_pages_free(fragmented), 1 + 2 * 3 + 1);
-        assert_eq!(huge_pages_free(""), 0);
-    }
-
     /// One test, as the region is the process's: large buffers come from
     /// it, small ones and those it has no room for from mimalloc; a buffer
     /// keeps its bytes when it grows, in place or moved; writing pages in
@@ -400,15 +337,6 @@ mod tests {
         // every byte written to them.
         let size = 64 << 20;
         let start = region_over(size);
-        // As `expect_large` advises, where the kernel has huge pages: a
-        // huge page faulted in by the helper holds buffers' pages too.
-        let _ = unsafe {
-            rustix::mm::madvise(
-                start as *mut std::ffi::c_void,
-                size,
-                rustix::mm::Advice::LinuxHugepage,
-            )
-        };
         let helper = std::thread::spawn(move || write_in(start, start + size));
         let mut buffers = Vec::new();
         for k in 0..120usize {
