@@ -53,31 +53,49 @@ pub fn parse_plan(text: &str, file: FileId) -> (Plan, Vec<Diagnostic>) {
 /// [`parse_plan`], with the fast path for common step lines or without it
 /// (to test that the two agree).
 fn read_plan(text: &str, file: FileId, quick: bool) -> (Plan, Vec<Diagnostic>) {
-    read_split(text, file, quick, second_half(text))
-}
-
-/// [`read_plan`], with the second half from `mid` read on another thread
-/// (to test that halves read as one pass does).
-fn read_split(
-    text: &str,
-    file: FileId,
-    quick: bool,
-    mid: Option<usize>,
-) -> (Plan, Vec<Diagnostic>) {
-    let read = match mid {
-        Some(mid) => read_in_halves(text, mid, file, quick),
-        None => {
-            let mut all = Part::new(line_count(text));
-            all.read(text, 0, 1, file, quick);
-            all
-        }
-    };
+    // At most a step a line: counting them is cheaper than growing a long
+    // plan's steps a dozen times.
+    let lines = memchr::memchr_iter(b'\n', text.as_bytes()).count() + 1;
     let mut plan = Plan {
-        format: read.format,
-        steps: read.steps,
-        stated_cost: read.stated_cost,
+        format: PlanFormat::Empty,
+        steps: Vec::with_capacity(lines),
+        stated_cost: None,
     };
-    let mut diags = read.diags;
+    let mut diags = Vec::new();
+    let mut in_ff = false;
+    let mut calls = quick::Calls::default();
+    for (i, (line_start, raw)) in lines_of(text).enumerate() {
+        let line = raw.strip_suffix('\r').unwrap_or(raw);
+        let place = quick::Place {
+            base: line_start,
+            file,
+            line: i as u32 + 1,
+        };
+        if let Some(format) = quick
+            .then(|| quick::step(line, place, &mut calls, &mut plan.steps))
+            .flatten()
+        {
+            if plan.format == PlanFormat::Empty {
+                plan.format = format;
+            }
+            continue;
+        }
+        match LineReader::new(line, place).read(&mut in_ff) {
+            Ok(Line::Blank) => {}
+            Ok(Line::Comment) => {
+                if let Some(c) = stated_cost(line, line_start, file) {
+                    plan.stated_cost = Some(c);
+                }
+            }
+            Ok(Line::Step(format, step)) => {
+                if plan.format == PlanFormat::Empty {
+                    plan.format = format;
+                }
+                plan.steps.push(step);
+            }
+            Err(d) => diags.push(d),
+        }
+    }
     if plan.steps.is_empty() && diags.is_empty() {
         diags.push(no_steps(file));
     }
@@ -92,134 +110,6 @@ fn read_split(
         plan.steps.sort_by(|a, b| time(a).total_cmp(&time(b)));
     }
     (plan, diags)
-}
-
-/// Plans at least this long are read in two halves at once, the second
-/// on another thread: a long plan's read is the longest stretch of a
-/// compile that a second core cannot otherwise share.
-const READ_IN_HALVES_FROM: usize = 1 << 20;
-
-/// Where a long plan's second half starts: the line after the middle.
-fn second_half(text: &str) -> Option<usize> {
-    if text.len() < READ_IN_HALVES_FROM {
-        return None;
-    }
-    let middle = text.len() / 2;
-    let mid = middle + memchr::memchr(b'\n', &text.as_bytes()[middle..])? + 1;
-    (mid < text.len()).then_some(mid)
-}
-
-/// Reads the lines before `mid` (a line's start) and those from it at
-/// once, as one pass would read them: the second half's lines numbered on
-/// from the first's, its steps after the first's.
-fn read_in_halves(text: &str, mid: usize, file: FileId, quick: bool) -> Part<'_> {
-    let (before, after) = (line_count(&text[..mid - 1]), line_count(&text[mid..]));
-    let first_after = before as u32 + 1;
-    let (mut first, second) = std::thread::scope(|s| {
-        let second = s.spawn(|| {
-            let mut part = Part::new(after);
-            part.read(&text[mid..], mid, first_after, file, quick);
-            part
-        });
-        // The first half ends at the `\n` before `mid`.
-        let mut first = Part::new(before + after);
-        first.read(&text[..mid - 1], 0, 1, file, quick);
-        (first, second.join())
-    });
-    let second = second.unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-    if first.in_ff {
-        // FF's numbered lines began in the first half: the second was read
-        // not knowing it, and is read again.
-        first.read(&text[mid..], mid, first_after, file, quick);
-    } else {
-        first.append(second);
-    }
-    first
-}
-
-/// Lines in `text` as [`lines_of`] cuts it: at most a step a line.
-/// Counting them is cheaper than growing a long plan's steps a dozen times.
-fn line_count(text: &str) -> usize {
-    memchr::memchr_iter(b'\n', text.as_bytes()).count() + 1
-}
-
-/// What reading a run of a plan's lines gives.
-struct Part<'a> {
-    format: PlanFormat,
-    steps: Vec<PlanStep>,
-    stated_cost: Option<StatedCost>,
-    diags: Vec<Diagnostic>,
-    /// FF's `step N:` has been read: later `N: NAME ARGS` lines are steps.
-    in_ff: bool,
-    /// The fast path's calls, by their text.
-    calls: quick::Calls<'a>,
-}
-
-impl<'a> Part<'a> {
-    fn new(lines: usize) -> Part<'a> {
-        Part {
-            format: PlanFormat::Empty,
-            steps: Vec::with_capacity(lines),
-            stated_cost: None,
-            diags: Vec::new(),
-            in_ff: false,
-            calls: quick::Calls::default(),
-        }
-    }
-
-    /// Reads the lines of `text`, which starts at `base` in its file, the
-    /// first of them line number `first_line`.
-    fn read(&mut self, text: &'a str, base: usize, first_line: u32, file: FileId, quick: bool) {
-        for (i, (start, raw)) in lines_of(text).enumerate() {
-            let line = raw.strip_suffix('\r').unwrap_or(raw);
-            let line_start = base + start;
-            let place = quick::Place {
-                base: line_start,
-                file,
-                line: first_line + i as u32,
-            };
-            if let Some(format) = quick
-                .then(|| quick::step(line, place, &mut self.calls, &mut self.steps))
-                .flatten()
-            {
-                self.note_format(format);
-                continue;
-            }
-            match LineReader::new(line, place).read(&mut self.in_ff) {
-                Ok(Line::Blank) => {}
-                Ok(Line::Comment) => {
-                    if let Some(c) = stated_cost(line, line_start, file) {
-                        self.stated_cost = Some(c);
-                    }
-                }
-                Ok(Line::Step(format, step)) => {
-                    self.note_format(format);
-                    self.steps.push(step);
-                }
-                Err(d) => self.diags.push(d),
-            }
-        }
-    }
-
-    /// A plan's format is its first step's.
-    fn note_format(&mut self, format: PlanFormat) {
-        if self.format == PlanFormat::Empty {
-            self.format = format;
-        }
-    }
-
-    /// What the lines after these read as, added after them. A call both
-    /// parts read is two equal values: the compiler treats steps that
-    /// repeat a ground action alike however they write it.
-    fn append(&mut self, later: Part<'a>) {
-        self.note_format(later.format);
-        self.steps.extend(later.steps);
-        if later.stated_cost.is_some() {
-            self.stated_cost = later.stated_cost;
-        }
-        self.diags.extend(later.diags);
-        self.in_ff = later.in_ff;
-    }
 }
 
 /// The warning on a plan of no steps (read or given as a value).
@@ -780,44 +670,6 @@ mod tests {
             }
             assert_readers_agree(&line, "random line");
         }
-    }
-
-    /// `lines` repeated until the text is long enough to be read in halves.
-    fn long(lines: &str) -> String {
-        lines.repeat(READ_IN_HALVES_FROM / lines.len() + 2)
-    }
-
-    fn assert_halves_read_as_one_pass(head: &str, body: &str) {
-        let text = format!("{head}{}", long(body));
-        let mid = second_half(&text).expect("long enough to read in halves");
-        for quick in [true, false] {
-            let (halves, one_pass) = (
-                read_split(&text, 3, quick, Some(mid)),
-                read_split(&text, 3, quick, None),
-            );
-            // Not `assert_eq!`: a megabyte of plan printed on failure.
-            assert!(halves == one_pass, "quick: {quick}");
-        }
-        assert_eq!(
-            read_plan(&text, 3, true),
-            read_split(&text, 3, true, Some(mid))
-        );
-    }
-
-    #[test]
-    fn a_long_plan_read_in_halves_reads_as_in_one_pass() {
-        // Timed and untimed steps, spacing and case, comments, a stated
-        // cost, errors, steps out of time order, CRLF: in both halves.
-        assert_halves_read_as_one_pass(
-            "",
-            include_str!("../../tests/fixtures/plan_halves/lines.tplan"),
-        );
-        // FF's numbered lines are steps only after its `step 0:`, which
-        // the first half has and the second does not.
-        assert_halves_read_as_one_pass(
-            "ff: found legal plan as follows\n\nstep    0: PICK-UP B\n",
-            include_str!("../../tests/fixtures/plan_halves/ff_steps.txt"),
-        );
     }
 
     #[test]
