@@ -1,10 +1,11 @@
 //! The writer. A regular file is replaced atomically: the new contents go
-//! to a temporary file in the target's folder, which takes the old file's
-//! mode and owner (or the umask's mode for a new file) and, when the old
-//! file is 1 MB or more, blocks for as many bytes at once (cut to the new
-//! length after), and then takes the target's name in one step (the two
-//! names are exchanged and the old file removed, or it is renamed over the
-//! target): a reader, or a failed emit, never meets half a file. Nothing is synced to disk: as compilers do,
+//! to a temporary file in the target's folder, which then takes the
+//! target's name in one step (the two names are exchanged and the old file
+//! removed, or it is renamed over the target). A reader, or a failed emit,
+//! never meets half a file. The temporary file takes the old file's mode
+//! and owner (or the umask's mode for a new file); when the old file is 1
+//! MB or more, blocks for as many bytes are allocated at once, and cut to
+//! the new length after. Nothing is synced to disk: as compilers do,
 //! btc leaves durability to the file system (an `fsync` cost 7-14 ms of a
 //! 100,000-step compile), so a power cut right after a compile can leave
 //! an empty output; compile again. What a rename would damage is written
