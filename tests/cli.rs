@@ -345,7 +345,7 @@ fn a_long_compile_is_the_same_with_its_pages_written_in_beforehand() {
     assert!(std::fs::metadata(&plan).unwrap().len() > 1 << 20);
     for (format, file) in [("pytrees", "tree.py"), ("btcpp", "tree.xml")] {
         let args = |out: &Path| -> Vec<std::ffi::OsString> {
-            let mut args: Vec<std::ffi::OsString> = vec![
+            vec![
                 "compile".into(),
                 example.join("rules.btrules").into(),
                 "--plan".into(),
@@ -355,9 +355,8 @@ fn a_long_compile_is_the_same_with_its_pages_written_in_beforehand() {
                 "--emit".into(),
                 format.into(),
                 "-o".into(),
-            ];
-            args.push(out.into());
-            args
+                out.into(),
+            ]
         };
         let (by_binary, in_process) =
             (dir.path().join(file), dir.path().join(format!("in-{file}")));
