@@ -140,12 +140,23 @@ pub fn load_job(
     let lower = |db: &Database, job| {
         let _ = db::compile(db, job);
     };
-    load_job_then(rules, plan, problem, domain, allow_invalid_plan, lower).map(|(job, _)| job)
+    load_job_then(
+        rules,
+        plan,
+        problem,
+        domain,
+        allow_invalid_plan,
+        lower,
+        || {},
+    )
+    .map(|(job, _)| job)
 }
 
 /// [`load_job`], with `meanwhile` run on a second core, on a clone of the
-/// database, while the plan is replayed; what it returns comes back beside
-/// the job (`None` for a plan still to be made: nothing to replay).
+/// database, while the plan is replayed, and `after_replay` run on this
+/// one once the replay is over, before waiting for `meanwhile`; what
+/// `meanwhile` returns comes back beside the job (`None` for a plan still
+/// to be made: nothing to replay, and neither runs).
 fn load_job_then<T: Send>(
     rules: &Path,
     plan: PlanSource,
@@ -153,6 +164,7 @@ fn load_job_then<T: Send>(
     domain: Option<&Path>,
     allow_invalid_plan: bool,
     meanwhile: impl FnOnce(&Database, db::CompileJob) -> T + Send,
+    after_replay: impl FnOnce(),
 ) -> anyhow::Result<(Job, Option<T>)> {
     let mut database = Database::new();
     let planned = matches!(plan, PlanSource::Planned(_));
@@ -170,6 +182,9 @@ fn load_job_then<T: Send>(
     let (mut diagnostics, made) = std::thread::scope(|s| {
         let made = beside.map(|db| s.spawn(move || meanwhile(&db, job)));
         let diagnostics = diagnostics_of(&database, job, planned, plan_file, allow_invalid_plan);
+        if made.is_some() {
+            after_replay();
+        }
         // A panic there is met again, and reported, on the way without it.
         (diagnostics, made.and_then(|m| m.join().ok()))
     });
@@ -258,13 +273,19 @@ pub fn record_paths_from(ir: &mut btc_ir::TreeIr, base: &Path) {
 
 pub fn compile(a: &CompileArgs) -> anyhow::Result<ExitCode> {
     expect_buffers_for(&a.plan);
+    // Once the replay is over, this core writes what the other emits.
+    let relay = btc_files::Relay::new();
     let (mut job, made) = load_job_then(
         &a.rules,
         PlanSource::File(FilePath::new(&a.plan)),
         a.problem.as_deref(),
         a.domain.as_deref(),
         a.allow_invalid_plan,
-        |db, job| emit_meanwhile(db, job, a),
+        |db, job| {
+            let _making = relay.making();
+            emit_meanwhile(db, job, a, &relay)
+        },
+        || relay.help(),
     )?;
     if let Some(made) = made.flatten() {
         if !has_errors(&job.diagnostics) {
@@ -451,14 +472,20 @@ fn expect_buffers_for(plan: &Path) {
 
 /// For `btc compile -o FILE` of a tree: lowers the job and emits it into
 /// a temporary file beside FILE, while the main thread replays the plan,
-/// so that a long plan's emit is off the critical path. `None` where the
+/// so that a long plan's emit is off the critical path; the output goes
+/// through `relay`, for the main thread to write once it is free. `None` where the
 /// output must wait for the verdict: `--check`, standard output, `--emit
 /// kb`, a folder still to be created (a refused job creates nothing), a
 /// target not replaced atomically, a job that does not lower or that a
 /// py_trees module cannot express (the usual way then reports why). Where
 /// the output waits, the tree is still lowered meanwhile, memoized for
 /// that way, as [`load_job`] does.
-fn emit_meanwhile(db: &Database, job: db::CompileJob, a: &CompileArgs) -> Option<Made> {
+fn emit_meanwhile(
+    db: &Database,
+    job: db::CompileJob,
+    a: &CompileArgs,
+    relay: &btc_files::Relay,
+) -> Option<Made> {
     let folder_is_there = |out: &Path| {
         out.parent()
             .is_none_or(|d| d.as_os_str().is_empty() || d.is_dir())
@@ -480,7 +507,11 @@ fn emit_meanwhile(db: &Database, job: db::CompileJob, a: &CompileArgs) -> Option
     // Counted while the steps just lowered are in the cache, not after the
     // output has been through it.
     let counts = StepCounts::of(&ir);
-    let staged = btc_files::stage(out, &mut |w| emit::emit_to(&ir, format, &a.options, w));
+    let staged = btc_files::stage_file(out, &mut |file| {
+        relay.relay(file, |hand| {
+            emit::emit_handing_over(&ir, format, &a.options, hand)
+        })
+    });
     let made = Made {
         staged: staged.ok()??,
         counts,

@@ -6,7 +6,7 @@
 //!
 //! `SubTree` elements get no `name` attribute: Groot2's monitor crashes on it.
 
-use crate::sink::Sink;
+use crate::sink::{Handover, Sink};
 use crate::sizing::{steps_with_nodes, StepSizer, SAMPLE_STEPS};
 use btc_ir::*;
 use std::fmt::Write as _;
@@ -451,6 +451,11 @@ pub fn emit(ir: &TreeIr, inline: bool) -> String {
 /// [`emit`] streamed to `w` as it is produced.
 pub fn emit_to(ir: &TreeIr, inline: bool, w: &mut dyn io::Write) -> io::Result<()> {
     emit_into(ir, inline, Sink::to(w)).map(drop)
+}
+
+/// [`emit_to`], its buffers handed over whole as they fill.
+pub fn emit_handing_over(ir: &TreeIr, inline: bool, hand: &mut Handover<'_>) -> io::Result<()> {
+    emit_into(ir, inline, Sink::hand(hand)).map(drop)
 }
 
 fn emit_into(ir: &TreeIr, inline: bool, sink: Sink<'_>) -> io::Result<String> {

@@ -9,6 +9,7 @@ pub mod executor;
 pub mod kb;
 pub mod pytrees;
 mod sink;
+pub use sink::Handover;
 mod sizing;
 
 use btc_ir::TreeIr;
@@ -146,5 +147,35 @@ pub fn emit_to(
         Format::Dot | Format::Mermaid | Format::Commands => {
             w.write_all(emit(ir, format, options).as_bytes())
         }
+    }
+}
+
+/// [`emit_to`], the buffers of BT.CPP XML and py_trees handed over whole
+/// as they fill (to be written on whichever core is free); the other
+/// formats' text is handed over in the pieces they write it in.
+pub fn emit_handing_over(
+    ir: &TreeIr,
+    format: Format,
+    options: &Options,
+    hand: &mut Handover<'_>,
+) -> std::io::Result<()> {
+    match format {
+        Format::Btcpp => btcpp::emit_handing_over(ir, options.inline, hand),
+        Format::Pytrees => pytrees::emit_handing_over(ir, &options.pytrees(), hand),
+        _ => emit_to(ir, format, options, &mut HandingOver(hand)),
+    }
+}
+
+/// A writer that hands over a copy of what it is given.
+struct HandingOver<'h, 'a>(&'h mut Handover<'a>);
+
+impl std::io::Write for HandingOver<'_, '_> {
+    fn write(&mut self, bytes: &[u8]) -> std::io::Result<usize> {
+        (self.0)(bytes.to_vec());
+        Ok(bytes.len())
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
     }
 }

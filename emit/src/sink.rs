@@ -11,10 +11,21 @@ use std::io::{self, Write};
 /// About how much text is handed to the writer at once.
 pub(crate) const CHUNK: usize = 1 << 20;
 
+/// What takes an emitter's full buffer and gives back an empty one to
+/// fill: the buffer is handed over whole, not copied (`btc compile -o`
+/// writes it on whichever core is free; see `btc_files::relay`).
+pub type Handover<'a> = dyn FnMut(Vec<u8>) -> Vec<u8> + 'a;
+
+/// Where the buffer goes.
+enum To<'w> {
+    Writer(&'w mut dyn Write),
+    Hand(&'w mut Handover<'w>),
+}
+
 /// Where an emitter's buffer goes at step boundaries: nowhere (the text
-/// is returned whole) or to a writer.
+/// is returned whole), to a writer, or handed over.
 pub(crate) struct Sink<'w> {
-    to: Option<&'w mut dyn Write>,
+    to: Option<To<'w>>,
     /// The first write error; later chunks are dropped, and the emit
     /// returns it.
     error: Option<io::Error>,
@@ -35,7 +46,15 @@ impl<'w> Sink<'w> {
 
     pub fn to(w: &'w mut dyn Write) -> Sink<'w> {
         Sink {
-            to: Some(w),
+            to: Some(To::Writer(w)),
+            error: None,
+            held: 0,
+        }
+    }
+
+    pub fn hand(h: &'w mut Handover<'w>) -> Sink<'w> {
+        Sink {
+            to: Some(To::Hand(h)),
             error: None,
             held: 0,
         }
@@ -77,13 +96,21 @@ impl<'w> Sink<'w> {
     }
 
     fn hand_over(&mut self, out: &mut String) {
-        if let Some(w) = self.to.as_mut() {
-            if self.error.is_none() {
-                if let Err(e) = w.write_all(out.as_bytes()) {
-                    self.error = Some(e);
+        match self.to.as_mut() {
+            Some(To::Writer(w)) => {
+                if self.error.is_none() {
+                    if let Err(e) = w.write_all(out.as_bytes()) {
+                        self.error = Some(e);
+                    }
                 }
+                out.clear();
             }
-            out.clear();
+            Some(To::Hand(h)) => {
+                let mut empty = h(std::mem::take(out).into_bytes());
+                empty.clear();
+                *out = String::from_utf8(empty).expect("an empty buffer is text");
+            }
+            None => {}
         }
     }
 
@@ -123,6 +150,32 @@ mod tests {
         assert!(out.len() > CHUNK, "held text stays in the buffer");
         sink.release();
         assert_eq!(sink.finish(out).unwrap(), "");
+        assert_eq!(String::from_utf8(got).unwrap(), expected);
+    }
+
+    /// Handed over, the buffers arrive whole and in order, none under a
+    /// hold, and the emitter fills the empty buffer it gets back.
+    #[test]
+    fn handed_over_buffers_arrive_in_order() {
+        let mut got = Vec::new();
+        let mut returned = 0;
+        let mut hand = |full: Vec<u8>| {
+            got.extend_from_slice(&full);
+            returned += 1;
+            Vec::with_capacity(full.capacity())
+        };
+        let mut sink = Sink::hand(&mut hand);
+        let mut out = String::new();
+        let mut expected = String::new();
+        for i in 0..200_000 {
+            let line = format!("step {i}\n");
+            out.push_str(&line);
+            expected.push_str(&line);
+            sink.step_done(&mut out);
+            assert!(out.len() < CHUNK + 64);
+        }
+        assert_eq!(sink.finish(out).unwrap(), "");
+        assert!(returned > 1, "handed over in chunks");
         assert_eq!(String::from_utf8(got).unwrap(), expected);
     }
 

@@ -13,8 +13,10 @@
 pub mod cleanup;
 pub mod compare;
 pub mod read;
+pub mod relay;
 pub mod write;
 
 pub use compare::{would_change, Comparison};
 pub use read::{read, ReadError};
-pub use write::{stage, write, write_with, Staged, Stream};
+pub use relay::Relay;
+pub use write::{stage, stage_file, write, write_with, Staged, Stream};

@@ -175,6 +175,15 @@ impl Staged {
 /// may not create files in): then [`write_with`] is the way, at the time
 /// the output may be written. If `produce` fails, nothing is left behind.
 pub fn stage(path: &Path, produce: &mut Produce<'_>) -> io::Result<Option<Staged>> {
+    stage_file(path, &mut |mut f: &File| produce(&mut f))
+}
+
+/// [`stage`], with `produce` given the temporary file itself (for a
+/// [`crate::Relay`], which writes to it from two threads).
+pub fn stage_file(
+    path: &Path,
+    produce: &mut dyn FnMut(&File) -> io::Result<()>,
+) -> io::Result<Option<Staged>> {
     let target = resolve(path)?;
     let Plan::Atomic(old) = plan(&target)? else {
         return Ok(None);
@@ -222,13 +231,19 @@ fn exchange(_: &Path, _: &Path) -> io::Result<()> {
 }
 
 fn atomic(target: &Path, produce: &mut Produce<'_>, old: Option<Old>) -> io::Result<Done<()>> {
-    Ok(match staged(target, produce, old)? {
-        Done::Written(s) => Done::Written(s.commit()?),
-        Done::Refused(e) => Done::Refused(e),
-    })
+    Ok(
+        match staged(target, &mut |mut f: &File| produce(&mut f), old)? {
+            Done::Written(s) => Done::Written(s.commit()?),
+            Done::Refused(e) => Done::Refused(e),
+        },
+    )
 }
 
-fn staged(target: &Path, produce: &mut Produce<'_>, old: Option<Old>) -> io::Result<Done<Staged>> {
+fn staged(
+    target: &Path,
+    produce: &mut dyn FnMut(&File) -> io::Result<()>,
+    old: Option<Old>,
+) -> io::Result<Done<Staged>> {
     let (guard, mut file) = {
         let mut attempt = 0;
         loop {
@@ -272,7 +287,7 @@ fn staged(target: &Path, produce: &mut Produce<'_>, old: Option<Old>) -> io::Res
     }
     let ahead = old.map_or(0, |o| o.len);
     let allocated = ahead >= ALLOCATE_AHEAD_FROM && allocate(&file, ahead);
-    produce(&mut file)?;
+    produce(&file)?;
     if allocated {
         // Shorter than the old file: the blocks past its end go.
         let end = io::Seek::stream_position(&mut file)?;

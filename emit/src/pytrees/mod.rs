@@ -17,7 +17,7 @@
 mod encode;
 pub mod names;
 
-use crate::sink::Sink;
+use crate::sink::{Handover, Sink};
 use crate::sizing::{steps_with_nodes, StepSizer, SAMPLE_STEPS};
 use btc_ir::vocab::{NodeSpec, PyTrees};
 use btc_ir::Count;
@@ -122,6 +122,15 @@ pub fn emit_to(
     w: &mut dyn std::io::Write,
 ) -> std::io::Result<()> {
     emit_into(ir, options, Sink::to(w)).map(drop)
+}
+
+/// [`emit_to`], its buffers handed over whole as they fill.
+pub fn emit_handing_over(
+    ir: &TreeIr,
+    options: &PyOptions<'_>,
+    hand: &mut Handover<'_>,
+) -> std::io::Result<()> {
+    emit_into(ir, options, Sink::hand(hand)).map(drop)
 }
 
 fn emit_into(ir: &TreeIr, options: &PyOptions<'_>, sink: Sink<'_>) -> std::io::Result<String> {
