@@ -129,32 +129,38 @@ impl<'w> Sink<'w> {
 mod tests {
     use super::*;
 
+    /// Writes 200,000 numbered lines through `sink`, holding it from line
+    /// `hold_from` on; returns what is left in the buffer, and every line.
+    fn feed(sink: &mut Sink, hold_from: Option<usize>) -> (String, String) {
+        let (mut out, mut expected) = (String::new(), String::new());
+        for i in 0..200_000 {
+            let line = format!("step {i}\n");
+            out.push_str(&line);
+            expected.push_str(&line);
+            if Some(i) == hold_from {
+                sink.hold();
+            }
+            sink.step_done(&mut out);
+            assert!(out.len() < CHUNK + 64 || hold_from.is_some_and(|h| i >= h));
+        }
+        (out, expected)
+    }
+
     /// Streamed text arrives whole and in order, in chunks of about
     /// [`CHUNK`]; none is handed over under a hold.
     #[test]
     fn chunks_arrive_in_order_and_not_under_a_hold() {
         let mut got = Vec::new();
         let mut sink = Sink::to(&mut got);
-        let mut out = String::new();
-        let mut expected = String::new();
-        for i in 0..200_000 {
-            let line = format!("step {i}\n");
-            out.push_str(&line);
-            expected.push_str(&line);
-            if i == 150_000 {
-                sink.hold();
-            }
-            sink.step_done(&mut out);
-            assert!(out.len() < CHUNK + 64 || i >= 150_000);
-        }
+        let (out, expected) = feed(&mut sink, Some(150_000));
         assert!(out.len() > CHUNK, "held text stays in the buffer");
         sink.release();
         assert_eq!(sink.finish(out).unwrap(), "");
         assert_eq!(String::from_utf8(got).unwrap(), expected);
     }
 
-    /// Handed over, the buffers arrive whole and in order, none under a
-    /// hold, and the emitter fills the empty buffer it gets back.
+    /// Handed over, the buffers arrive whole and in order, and the
+    /// emitter fills the empty buffer it gets back.
     #[test]
     fn handed_over_buffers_arrive_in_order() {
         let mut got = Vec::new();
@@ -165,15 +171,7 @@ mod tests {
             Vec::with_capacity(full.capacity())
         };
         let mut sink = Sink::hand(&mut hand);
-        let mut out = String::new();
-        let mut expected = String::new();
-        for i in 0..200_000 {
-            let line = format!("step {i}\n");
-            out.push_str(&line);
-            expected.push_str(&line);
-            sink.step_done(&mut out);
-            assert!(out.len() < CHUNK + 64);
-        }
+        let (out, expected) = feed(&mut sink, None);
         assert_eq!(sink.finish(out).unwrap(), "");
         assert!(returned > 1, "handed over in chunks");
         assert_eq!(String::from_utf8(got).unwrap(), expected);
