@@ -1077,8 +1077,9 @@ def _decorator_name(kind, arg):
 
 
 class _Builder:
-    def __init__(self, plan, trees, classes):
+    def __init__(self, plan, trees, classes, step_nodes):
         self.plan, self.trees, self.classes = plan, trees, classes
+        self.step_nodes = step_nodes
 
     def value(self, v, args):
         if isinstance(v, tuple) and v[:1] == ("$",):
@@ -1100,7 +1101,11 @@ class _Builder:
                 k + 1,
                 self.plan.steps[k].label() if k < len(self.plan.steps) else "(?)",
             )
-            return PlanStep(label, self.build(spec[2], args, depth, k), k)
+            node = spec[2]
+            if isinstance(node, int):
+                # A node the steps share, in `STEP_NODES`.
+                node = self.step_nodes[node]
+            return PlanStep(label, self.build(node, args, depth, k), k)
         if kind in ("C", "K"):
             tree = self.trees[spec[1]]
             if kind == "C":
@@ -1161,11 +1166,12 @@ class _Builder:
         return Parallel(name, spec[2], spec[3], children=kids)
 
 
-def build_tree(spec, trees, classes, plan):
+def build_tree(spec, trees, classes, plan, step_nodes=()):
     """The py_trees behaviours for a generated module's `ROOT` (`trees`:
-    its `TREES`, `classes`: its `(node id, leaf class)` pairs by index)."""
+    its `TREES`, `classes`: its `(node id, leaf class)` pairs by index,
+    `step_nodes`: its `STEP_NODES`, which a step names by index)."""
     with _Sharing():
-        return _Builder(plan, trees, classes).build(spec, {}, 0, None)
+        return _Builder(plan, trees, classes, step_nodes).build(spec, {}, 0, None)
 
 
 # ---------------------------------------------------------------------------

@@ -163,16 +163,21 @@ class ControlTest(unittest.TestCase):
         self.assertEqual(act.status, Status.INVALID)
 
 
+# A move from `?#1` to `?#2`: its start wants the first, its end makes it the
+# second.
+MOVE = (
+    "move",
+    ("at", "?#0", "?#1"),
+    None,
+    None,
+    None,
+    (":and", (":del", ("at", "?#0", "?#1")), ("at", "?#0", "?#2")),
+)
+
+
 class StepTest(unittest.TestCase):
     def test_a_step_applies_its_effects_once_and_records_its_events(self):
-        shape = (
-            "move",
-            ("at", "?#0", "?#1"),
-            None,
-            None,
-            None,
-            (":and", (":del", ("at", "?#0", "?#1")), ("at", "?#0", "?#2")),
-        )
+        shape = MOVE
         plan = rt.Plan((shape,), ((0, ("t1", "p1", "v1")),))
         w = world(init=(("at", "t1", "p1"),), goal=("at", "t1", "v1"))
         kb = rt.KnowledgeBase(w, plan)
@@ -186,6 +191,27 @@ class StepTest(unittest.TestCase):
         self.assertTrue(result.goal_reached)
         self.assertEqual(result.events, [(1, "start", 1), (2, "end", 1)])
         self.assertEqual(result.kb, ["(at t1 v1)"])
+
+    def test_steps_that_name_a_shared_node_each_build_their_own(self):
+        shape = MOVE
+        plan = rt.Plan((shape,), ((0, ("t1", "p1", "v1")), (0, ("t1", "v1", "p1"))))
+        w = world(init=(("at", "t1", "p1"),), goal=("at", "t1", "p1"))
+        kb = rt.KnowledgeBase(w, plan)
+
+        class Move(rt.Action):
+            NODE_ID = "Move"
+
+        spec = ("Q", None, (("S", 0, 0), ("S", 1, 0)))
+        root = rt.build_tree(spec, (), (("Move", Move),), plan, (("L", 0, None, ()),))
+        first, second = (s.children[0] for s in root.children)
+        self.assertIsNot(first, second)
+        self.assertEqual((first.step, second.step), (0, 1))
+        result = rt.run(root, kb, 10)
+        self.assertEqual(result.status, Status.SUCCESS)
+        self.assertTrue(result.goal_reached)
+        self.assertEqual(
+            result.events, [(1, "start", 1), (2, "end", 1), (2, "start", 2), (3, "end", 2)]
+        )
 
     def test_an_action_fails_when_its_step_cannot_start(self):
         shape = ("move", ("at", "?#0", "?#1"), None, None, None, None)

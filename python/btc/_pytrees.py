@@ -31,6 +31,7 @@ class TreeData:
         self.steps = literals["STEPS"]
         self.trees = literals["TREES"]
         self.root = literals["ROOT"]
+        self.step_nodes = literals.get("STEP_NODES", ())
         self.max_ticks = literals.get("MAX_TICKS", 10000)
 
 
@@ -85,5 +86,9 @@ def plan(data):
 def build(data, nodes=None, the_plan=None):
     """The root behaviour of the tree."""
     return btc_runtime.build_tree(
-        data.root, data.trees, leaf_classes(data, nodes), the_plan or plan(data)
+        data.root,
+        data.trees,
+        leaf_classes(data, nodes),
+        the_plan or plan(data),
+        data.step_nodes,
     )

@@ -21,6 +21,7 @@ const LITERALS: &[&str] = &[
     "STEPS",
     "TREES",
     "ROOT",
+    "STEP_NODES",
     "MAX_TICKS",
     "NODE_CLASS_NAMES",
 ];

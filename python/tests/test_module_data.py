@@ -14,7 +14,7 @@ from btc import _btc
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 FIXTURE = pathlib.Path(__file__).parent / "fixtures" / "generated_module.txt"
 EXAMPLES = ["ariac", "nist_kitting", "p3_assembler", "two_robots"]
-LITERALS = ("SHAPES", "STEPS", "TREES", "ROOT", "MAX_TICKS", "NODE_CLASS_NAMES")
+LITERALS = ("SHAPES", "STEPS", "TREES", "ROOT", "STEP_NODES", "MAX_TICKS", "NODE_CLASS_NAMES")
 
 
 class _Floats(ast.NodeTransformer):
@@ -80,6 +80,7 @@ def test_the_forms_that_need_care_read_as_python_reads_them():
     assert ours["defined"]["Grasp"][1]["FORMULA"][0] == ":or"
     assert ours["classes"][2] == ("Place", "Action")
     assert ours["literals"]["MAX_TICKS"] == 250
+    assert ours["literals"]["STEP_NODES"] == (("C", 0, ("r1",)),)
 
 
 @pytest.mark.parametrize(

@@ -89,6 +89,25 @@ fn module_import(node_module: &str) -> (String, String) {
     }
 }
 
+/// The distinct nodes the plan's steps run, numbered as first met.
+#[derive(Default)]
+struct StepNodes<'a> {
+    index: rustc_hash::FxHashMap<*const Node, usize>,
+    nodes: Vec<&'a Node>,
+}
+
+impl<'a> StepNodes<'a> {
+    /// `n`'s index, numbering it if it is new.
+    fn index_of(&mut self, n: &'a Arc<Node>) -> usize {
+        let next = self.nodes.len();
+        let i = *self.index.entry(Arc::as_ptr(n)).or_insert(next);
+        if i == next {
+            self.nodes.push(n);
+        }
+        i
+    }
+}
+
 /// How a leaf id is built: its index in `CLASSES` and the class expression.
 struct LeafClass {
     index: usize,
@@ -99,11 +118,12 @@ struct Emitter<'a, 'w> {
     out: String,
     classes: HashMap<&'a str, LeafClass>,
     trees: HashMap<&'a str, usize>,
-    /// Steps' nodes as Python, by the address of the shared node and the
-    /// indent they were written at: the steps that repeat a ground action
-    /// share it, and it is written once. (The IR is borrowed for the whole
-    /// emit, so an address names one value.)
-    step_nodes: std::cell::RefCell<rustc_hash::FxHashMap<(usize, usize), Box<str>>>,
+    /// The nodes of the steps, in the order a step first names them, and
+    /// each one's index in `STEP_NODES` by its address: the steps that
+    /// repeat a ground action share their node, which the module writes
+    /// once. (The IR is borrowed for the whole emit, so an address names
+    /// one value.)
+    step_nodes: std::cell::RefCell<StepNodes<'a>>,
     /// Sizes the buffer by the main tree's first steps (when it is
     /// returned whole).
     root_sizer: std::cell::RefCell<StepSizer>,
@@ -454,7 +474,8 @@ impl<'a> Emitter<'a, '_> {
              # The tree. Nodes: (\"Q\"|\"q\"|\"F\"|\"f\", name, children) sequence, reactive\n\
              # sequence, fallback, reactive fallback; (\"P\", name, success, failure,\n\
              # children); (\"D\", kind, arg, name, child); (\"L\", class, name, ports);\n\
-             # (\"S\", step, child); (\"C\", tree, args) / (\"K\", tree, named args) calls\n\
+             # (\"S\", step, i) runs STEP_NODES[i] as plan step `step`; (\"C\", tree, args)\n\
+             # / (\"K\", tree, named args) calls\n\
              # TREES[tree], (params, node); (\"$\", param) is a parameter's value.\n\n\
              TREES = (\n",
         );
@@ -470,13 +491,25 @@ impl<'a> Emitter<'a, '_> {
         }
         out.push_str(")\n\nROOT = ");
         self.node(&ir.root, &mut out, 0);
-        out.push('\n');
+        out.push_str(
+            "\n\n# A step's node: (\"S\", step, i) runs STEP_NODES[i], which the steps\n\
+             # that repeat a ground action share.\n\n\
+             STEP_NODES = (\n",
+        );
+        let nodes = std::mem::take(&mut self.step_nodes.get_mut().nodes);
+        for n in nodes {
+            out.push_str("    ");
+            self.node(n, &mut out, 1);
+            out.push_str(",\n");
+            self.sink.get_mut().step_done(&mut out);
+        }
+        out.push_str(")\n");
         self.out = out;
     }
 
     /// Writes node `n`; children of a control node go one per line at
     /// `indent + 1` levels.
-    fn node(&self, n: &Node, o: &mut String, indent: usize) {
+    fn node(&self, n: &'a Node, o: &mut String, indent: usize) {
         match n {
             Node::Control {
                 control,
@@ -540,7 +573,7 @@ impl<'a> Emitter<'a, '_> {
                 o.push_str("(\"S\", ");
                 push_int(o, *step);
                 o.push_str(", ");
-                self.shared_node(child, o, indent);
+                push_int(o, self.step_nodes.borrow_mut().index_of(child));
                 o.push(')');
                 // Room after the steps for the module's end.
                 self.root_sizer.borrow_mut().written(o, 4096);
@@ -573,20 +606,6 @@ impl<'a> Emitter<'a, '_> {
         }
     }
 
-    /// [`Emitter::node`] of a node that steps share: written once per
-    /// indent, then copied.
-    fn shared_node(&self, n: &Arc<Node>, o: &mut String, indent: usize) {
-        let key = (Arc::as_ptr(n) as usize, indent);
-        if let Some(text) = self.step_nodes.borrow().get(&key) {
-            return o.push_str(text);
-        }
-        let start = o.len();
-        self.sink.borrow_mut().hold();
-        self.node(n, o, indent);
-        self.sink.borrow_mut().release();
-        self.step_nodes.borrow_mut().insert(key, o[start..].into());
-    }
-
     /// `(("port", value), ...)`
     fn ports_tuple(&self, ports: &[Port], o: &mut String) {
         o.push('(');
@@ -608,7 +627,7 @@ impl<'a> Emitter<'a, '_> {
              MAX_TICKS = {max_ticks}\n\n\n\
              def create_behavior_tree():\n    \
              \"\"\"Builds the behaviour tree and returns its root.\"\"\"\n    \
-             return build_tree(ROOT, TREES, CLASSES, PLAN)\n\n\n\
+             return build_tree(ROOT, TREES, CLASSES, PLAN, STEP_NODES)\n\n\n\
              def main(argv=None):\n    \
              \"\"\"Ticks the tree to the end in a fresh knowledge base and prints the\n    \
              result; returns 0 when the tree succeeded and the goal holds.\"\"\"\n    \

@@ -125,6 +125,7 @@ pub(crate) const RESERVED: &[&str] = &[
     "ROOT",
     "SHAPES",
     "STEPS",
+    "STEP_NODES",
     "TREES",
     "WORLD",
     "create_behavior_tree",
