@@ -89,21 +89,27 @@ fn module_import(node_module: &str) -> (String, String) {
     }
 }
 
-/// The distinct nodes the plan's steps run, numbered as first met.
+/// The distinct nodes the plan's steps run, as Python, numbered as first
+/// met. Told apart by their text, so that the module is the same however
+/// the IR shares its nodes; found by address first, so that a node the
+/// steps share is written out once.
 #[derive(Default)]
-struct StepNodes<'a> {
-    index: rustc_hash::FxHashMap<*const Node, usize>,
-    nodes: Vec<&'a Node>,
+struct StepNodes {
+    by_address: rustc_hash::FxHashMap<*const Node, usize>,
+    by_text: rustc_hash::FxHashMap<Box<str>, usize>,
+    texts: Vec<Box<str>>,
 }
 
-impl<'a> StepNodes<'a> {
-    /// `n`'s index, numbering it if it is new.
-    fn index_of(&mut self, n: &'a Arc<Node>) -> usize {
-        let next = self.nodes.len();
-        let i = *self.index.entry(Arc::as_ptr(n)).or_insert(next);
+impl StepNodes {
+    /// The index of the node at `address`, written as `text`.
+    fn intern(&mut self, address: *const Node, text: String) -> usize {
+        let next = self.texts.len();
+        let text = text.into_boxed_str();
+        let i = *self.by_text.entry(text.clone()).or_insert(next);
         if i == next {
-            self.nodes.push(n);
+            self.texts.push(text);
         }
+        self.by_address.insert(address, i);
         i
     }
 }
@@ -123,7 +129,7 @@ struct Emitter<'a, 'w> {
     /// repeat a ground action share their node, which the module writes
     /// once. (The IR is borrowed for the whole emit, so an address names
     /// one value.)
-    step_nodes: std::cell::RefCell<StepNodes<'a>>,
+    step_nodes: std::cell::RefCell<StepNodes>,
     /// Sizes the buffer by the main tree's first steps (when it is
     /// returned whole).
     root_sizer: std::cell::RefCell<StepSizer>,
@@ -496,10 +502,10 @@ impl<'a> Emitter<'a, '_> {
              # that repeat a ground action share.\n\n\
              STEP_NODES = (\n",
         );
-        let nodes = std::mem::take(&mut self.step_nodes.get_mut().nodes);
-        for n in nodes {
+        let texts = std::mem::take(&mut self.step_nodes.get_mut().texts);
+        for text in texts {
             out.push_str("    ");
-            self.node(n, &mut out, 1);
+            out.push_str(&text);
             out.push_str(",\n");
             self.sink.get_mut().step_done(&mut out);
         }
@@ -573,7 +579,7 @@ impl<'a> Emitter<'a, '_> {
                 o.push_str("(\"S\", ");
                 push_int(o, *step);
                 o.push_str(", ");
-                push_int(o, self.step_nodes.borrow_mut().index_of(child));
+                push_int(o, self.step_node_index(child));
                 o.push(')');
                 // Room after the steps for the module's end.
                 self.root_sizer.borrow_mut().written(o, 4096);
@@ -604,6 +610,20 @@ impl<'a> Emitter<'a, '_> {
                 }
             },
         }
+    }
+
+    /// The index in `STEP_NODES` of a step's node.
+    fn step_node_index(&self, n: &'a Arc<Node>) -> usize {
+        let address = Arc::as_ptr(n);
+        if let Some(&i) = self.step_nodes.borrow().by_address.get(&address) {
+            return i;
+        }
+        let mut text = String::new();
+        // Nothing is handed over while the node is written aside.
+        self.sink.borrow_mut().hold();
+        self.node(n, &mut text, 1);
+        self.sink.borrow_mut().release();
+        self.step_nodes.borrow_mut().intern(address, text)
     }
 
     /// `(("port", value), ...)`
