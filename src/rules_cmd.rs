@@ -473,13 +473,13 @@ fn expect_buffers_for(plan: &Path) {
 /// For `btc compile -o FILE` of a tree: lowers the job and emits it into
 /// a temporary file beside FILE, while the main thread replays the plan,
 /// so that a long plan's emit is off the critical path; the output goes
-/// through `relay`, for the main thread to write once it is free. `None` where the
-/// output must wait for the verdict: `--check`, standard output, `--emit
-/// kb`, a folder still to be created (a refused job creates nothing), a
-/// target not replaced atomically, a job that does not lower or that a
-/// py_trees module cannot express (the usual way then reports why). Where
-/// the output waits, the tree is still lowered meanwhile, memoized for
-/// that way, as [`load_job`] does.
+/// through `relay`, for the main thread to write once it is free. `None`
+/// where the output must wait for the verdict: `--check`, standard
+/// output, `--emit kb`, a folder still to be created (a refused job
+/// creates nothing), a target not replaced atomically, a job that does not
+/// lower or that a py_trees module cannot express (the usual way then
+/// reports why). Where the output waits, the tree is still lowered
+/// meanwhile, memoized for that way, as [`load_job`] does.
 fn emit_meanwhile(
     db: &Database,
     job: db::CompileJob,

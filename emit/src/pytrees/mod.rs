@@ -96,22 +96,7 @@ fn module_import(node_module: &str) -> (String, String) {
 #[derive(Default)]
 struct StepNodes {
     by_address: rustc_hash::FxHashMap<*const Node, usize>,
-    by_text: rustc_hash::FxHashMap<Box<str>, usize>,
-    texts: Vec<Box<str>>,
-}
-
-impl StepNodes {
-    /// The index of the node at `address`, written as `text`.
-    fn intern(&mut self, address: *const Node, text: String) -> usize {
-        let next = self.texts.len();
-        let text = text.into_boxed_str();
-        let i = *self.by_text.entry(text.clone()).or_insert(next);
-        if i == next {
-            self.texts.push(text);
-        }
-        self.by_address.insert(address, i);
-        i
-    }
+    texts: indexmap::IndexSet<Box<str>, rustc_hash::FxBuildHasher>,
 }
 
 /// How a leaf id is built: its index in `CLASSES` and the class expression.
@@ -623,7 +608,10 @@ impl<'a> Emitter<'a, '_> {
         self.sink.borrow_mut().hold();
         self.node(n, &mut text, 1);
         self.sink.borrow_mut().release();
-        self.step_nodes.borrow_mut().intern(address, text)
+        let mut nodes = self.step_nodes.borrow_mut();
+        let (i, _) = nodes.texts.insert_full(text.into_boxed_str());
+        nodes.by_address.insert(address, i);
+        i
     }
 
     /// `(("port", value), ...)`
