@@ -480,11 +480,11 @@ fn expect_buffers_for(plan: &Path) {
 /// lower or that a py_trees module cannot express (the usual way then
 /// reports why). Where the output waits, the tree is still lowered
 /// meanwhile, memoized for that way, as [`load_job`] does.
-fn emit_meanwhile(
+fn emit_meanwhile<'a>(
     db: &Database,
     job: db::CompileJob,
-    a: &CompileArgs,
-    relay: &btc_files::Relay,
+    a: &'a CompileArgs,
+    relay: &btc_files::Relay<'a>,
 ) -> Option<Made> {
     let folder_is_there = |out: &Path| {
         out.parent()
@@ -507,10 +507,25 @@ fn emit_meanwhile(
     // Counted while the steps just lowered are in the cache, not after the
     // output has been through it.
     let counts = StepCounts::of(&ir);
+    // The helper, once the replay is over, may make the output's second
+    // part (a py_trees module's tree) while this thread makes its first.
+    let ir = Arc::new(ir);
     let staged = btc_files::stage_file(out, &mut |file| {
-        relay.relay(file, |hand| {
-            emit::emit_handing_over(&ir, format, &a.options, hand)
-        })
+        let (first, second) = match emit::parts(format) {
+            [first, second] => (*first, Some(*second)),
+            _ => (emit::Part::First, None),
+        };
+        let later = second.map(|part| {
+            let ir = ir.clone();
+            Box::new(move |hand: &mut btc_files::relay::Produce<'_>| {
+                emit::emit_part_handing_over(&ir, format, &a.options, part, hand)
+            }) as btc_files::relay::Later<'a>
+        });
+        relay.relay_parts(
+            file,
+            |hand| emit::emit_part_handing_over(&ir, format, &a.options, first, hand),
+            later,
+        )
     });
     let made = Made {
         staged: staged.ok()??,

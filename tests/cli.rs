@@ -278,8 +278,9 @@ fn compile_check_says_whether_the_output_would_change_and_writes_nothing() {
 }
 
 /// A long plan's tree is streamed: to a file and to standard output it is
-/// the same bytes, and a reader that stops early (`| head`) ends the
-/// compile quietly, not with a panic.
+/// the same bytes (a py_trees module's two parts made on two threads for
+/// the file), and a reader that stops early (`| head`) ends the compile
+/// quietly, not with a panic.
 #[test]
 fn a_long_plan_streams_to_a_file_and_to_a_reader_that_stops() {
     let dir = tempfile::tempdir().unwrap();
@@ -314,6 +315,13 @@ fn a_long_plan_streams_to_a_file_and_to_a_reader_that_stops() {
     let to_file = support::btc_in(dir.path(), &[&args[..], &["-o", "tree.xml"]].concat());
     assert!(to_file.status.success());
     assert!(std::fs::read(dir.path().join("tree.xml")).unwrap() == to_stdout.stdout);
+    let py_args = [&args[..5], &["pytrees", "--allow-invalid-plan"]].concat();
+    let py_stdout = support::btc_in(dir.path(), &py_args);
+    assert!(py_stdout.status.success());
+    assert!(py_stdout.stdout.len() > 1 << 20);
+    let py_file = support::btc_in(dir.path(), &[&py_args[..], &["-o", "tree.py"]].concat());
+    assert!(py_file.status.success());
+    assert!(std::fs::read(dir.path().join("tree.py")).unwrap() == py_stdout.stdout);
 
     let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_btc"))
         .args(args)

@@ -166,6 +166,44 @@ pub fn emit_handing_over(
     }
 }
 
+/// The parts an output can be made in on two threads at once, in the
+/// order their texts follow each other: py_trees in two (its plan, then
+/// its tree), the other formats in one.
+pub fn parts(format: Format) -> &'static [Part] {
+    match format {
+        Format::Pytrees => &[Part::First, Part::Second],
+        _ => &[Part::First],
+    }
+}
+
+/// One of the [`parts`] of an output.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Part {
+    First,
+    Second,
+}
+
+/// [`emit_handing_over`] of one of `format`'s [`parts`]: the parts' texts,
+/// one after the other, are the whole output's.
+pub fn emit_part_handing_over(
+    ir: &TreeIr,
+    format: Format,
+    options: &Options,
+    part: Part,
+    hand: &mut Handover<'_>,
+) -> std::io::Result<()> {
+    match (format, part) {
+        (Format::Pytrees, Part::First) => {
+            pytrees::emit_part_handing_over(ir, &options.pytrees(), pytrees::Part::Plan, hand)
+        }
+        (Format::Pytrees, Part::Second) => {
+            pytrees::emit_part_handing_over(ir, &options.pytrees(), pytrees::Part::Tree, hand)
+        }
+        (_, Part::First) => emit_handing_over(ir, format, options, hand),
+        (_, Part::Second) => Ok(()),
+    }
+}
+
 /// A writer that hands over a copy of what it is given.
 struct HandingOver<'h, 'a>(&'h mut Handover<'a>);
 

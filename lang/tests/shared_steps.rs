@@ -3,9 +3,11 @@
 //! output must not depend on that: each emitter writes the same text for
 //! the compiled IR as for a copy of it in which nothing is shared (the IR
 //! read back from its JSON, where every step has its own values). Nor
-//! on streaming: each emitter streams the bytes it returns whole.
+//! on streaming: each emitter streams the bytes it returns whole, and its
+//! parts (made on two threads by `btc compile -o`) follow each other into
+//! the same bytes.
 
-use btc_emit::{emit, emit_to, pytrees::Runtime, Format, Options};
+use btc_emit::{emit, emit_part_handing_over, emit_to, parts, pytrees::Runtime, Format, Options};
 use btc_ir::TreeIr;
 use btc_lang::db::{compile, CompileJob, Database};
 use std::path::Path;
@@ -82,6 +84,20 @@ fn assert_streams_as_whole(
     assert!(
         streamed == whole.as_bytes(),
         "{what}: {} (inline: {}) streams other bytes than it returns",
+        format.name(),
+        options.inline
+    );
+    let mut handed = Vec::new();
+    for &part in parts(format) {
+        emit_part_handing_over(ir, format, options, part, &mut |buffer: Vec<u8>| {
+            handed.extend_from_slice(&buffer);
+            Vec::with_capacity(buffer.capacity())
+        })
+        .expect("handing over never fails");
+    }
+    assert!(
+        handed == whole.as_bytes(),
+        "{what}: {} (inline: {}) makes other bytes in parts than whole",
         format.name(),
         options.inline
     );

@@ -144,31 +144,97 @@ pub fn emit_handing_over(
     emit_into(ir, options, Sink::hand(hand)).map(drop)
 }
 
-fn emit_into(ir: &TreeIr, options: &PyOptions<'_>, sink: Sink<'_>) -> std::io::Result<String> {
-    let mut e = Emitter {
-        ir,
-        // Room for the first steps: the rows and the main tree are sized
-        // by them as they are written.
-        out: String::with_capacity(sink.capacity(256 * ir.steps.len().min(SAMPLE_STEPS) + 16_384)),
-        classes: HashMap::new(),
-        trees: ir
-            .trees
-            .iter()
-            .enumerate()
-            .map(|(i, t)| (t.id.as_str(), i))
-            .collect(),
-        step_nodes: Default::default(),
-        root_sizer: std::cell::RefCell::new(sink.sizer(steps_with_nodes(ir))),
-        sink: std::cell::RefCell::new(sink),
+/// The module's two parts, whose texts follow each other: the plan (the
+/// header, the world and the steps' rows, most of a long plan's module),
+/// then the tree (the leaf classes, the trees, the steps' nodes). Neither
+/// needs the other, so two threads can make them at once.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Part {
+    Plan,
+    Tree,
+}
+
+/// [`emit_handing_over`] of one [`Part`] of the module.
+pub fn emit_part_handing_over(
+    ir: &TreeIr,
+    options: &PyOptions<'_>,
+    part: Part,
+    hand: &mut Handover<'_>,
+) -> std::io::Result<()> {
+    let models = models(ir);
+    let mut e = Emitter::new(ir, Sink::hand(hand));
+    match part {
+        Part::Plan => e.plan_part(options),
+        Part::Tree => e.tree_part(&models, options),
+    }
+    e.sink.into_inner().finish(e.out).map(drop)
+}
+
+/// The leaf models, with a model for every leaf id the trees use.
+fn models(ir: &TreeIr) -> Vec<NodeModel> {
+    let mut models: Vec<NodeModel> = ir.nodes.clone();
+    let mut add = |n: &Node| {
+        if let Node::Leaf { leaf, id, .. } = n {
+            if !models.iter().any(|m| m.id == *id) {
+                models.push(NodeModel {
+                    id: id.clone(),
+                    kind: *leaf,
+                    ports: Vec::new(),
+                    formula: None,
+                });
+            }
+        }
     };
-    e.header(options);
-    e.world();
-    e.steps();
-    let models = e.models();
-    e.leaf_classes(&models, options.node_module);
-    e.tree();
-    e.footer();
+    for t in &ir.trees {
+        t.root.walk(&mut add);
+    }
+    // The main tree has one node per step at least: walk it only for
+    // leaves outside the rules' trees.
+    ir.root.walk_distinct(&mut add);
+    models
+}
+
+fn emit_into(ir: &TreeIr, options: &PyOptions<'_>, sink: Sink<'_>) -> std::io::Result<String> {
+    let models = models(ir);
+    let mut e = Emitter::new(ir, sink);
+    e.plan_part(options);
+    e.tree_part(&models, options);
     e.sink.into_inner().finish(e.out)
+}
+
+impl<'a, 'w> Emitter<'a, 'w> {
+    fn new(ir: &'a TreeIr, sink: Sink<'w>) -> Emitter<'a, 'w> {
+        Emitter {
+            ir,
+            // Room for the first steps: the rows and the main tree are
+            // sized by them as they are written.
+            out: String::with_capacity(
+                sink.capacity(256 * ir.steps.len().min(SAMPLE_STEPS) + 16_384),
+            ),
+            classes: HashMap::new(),
+            trees: ir
+                .trees
+                .iter()
+                .enumerate()
+                .map(|(i, t)| (t.id.as_str(), i))
+                .collect(),
+            step_nodes: Default::default(),
+            root_sizer: std::cell::RefCell::new(sink.sizer(steps_with_nodes(ir))),
+            sink: std::cell::RefCell::new(sink),
+        }
+    }
+
+    fn plan_part(&mut self, options: &PyOptions<'_>) {
+        self.header(options);
+        self.world();
+        self.steps();
+    }
+
+    fn tree_part(&mut self, models: &'a [NodeModel], options: &PyOptions<'_>) {
+        self.leaf_classes(models, options.node_module);
+        self.tree();
+        self.footer();
+    }
 }
 
 impl<'a> Emitter<'a, '_> {
@@ -389,30 +455,6 @@ impl<'a> Emitter<'a, '_> {
             self.sink.get_mut().step_done(o);
         }
         o.push_str(")\n\nPLAN = Plan(SHAPES, STEPS)\n");
-    }
-
-    /// The leaf models, with a model for every leaf id the trees use.
-    fn models(&self) -> Vec<NodeModel> {
-        let mut models: Vec<NodeModel> = self.ir.nodes.clone();
-        let mut add = |n: &Node| {
-            if let Node::Leaf { leaf, id, .. } = n {
-                if !models.iter().any(|m| m.id == *id) {
-                    models.push(NodeModel {
-                        id: id.clone(),
-                        kind: *leaf,
-                        ports: Vec::new(),
-                        formula: None,
-                    });
-                }
-            }
-        };
-        for t in &self.ir.trees {
-            t.root.walk(&mut add);
-        }
-        // The main tree has one node per step at least: walk it only for
-        // leaves outside the rules' trees.
-        self.ir.root.walk_distinct(&mut add);
-        models
     }
 
     fn leaf_classes(&mut self, models: &'a [NodeModel], node_module: Option<&str>) {
