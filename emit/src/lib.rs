@@ -193,12 +193,7 @@ pub fn emit_part_handing_over(
     hand: &mut Handover<'_>,
 ) -> std::io::Result<()> {
     match (format, part) {
-        (Format::Pytrees, Part::First) => {
-            pytrees::emit_part_handing_over(ir, &options.pytrees(), pytrees::Part::Plan, hand)
-        }
-        (Format::Pytrees, Part::Second) => {
-            pytrees::emit_part_handing_over(ir, &options.pytrees(), pytrees::Part::Tree, hand)
-        }
+        (Format::Pytrees, _) => pytrees::emit_part_handing_over(ir, &options.pytrees(), part, hand),
         (_, Part::First) => emit_handing_over(ir, format, options, hand),
         (_, Part::Second) => Ok(()),
     }

@@ -19,6 +19,7 @@ pub mod names;
 
 use crate::sink::{Handover, Sink};
 use crate::sizing::{steps_with_nodes, StepSizer, SAMPLE_STEPS};
+use crate::Part;
 use btc_ir::vocab::{NodeSpec, PyTrees};
 use btc_ir::Count;
 use btc_ir::{push_int, Label, LabelPart, LeafKind, Node, NodeModel, Port, StepInfo, TreeIr};
@@ -144,28 +145,26 @@ pub fn emit_handing_over(
     emit_into(ir, options, Sink::hand(hand)).map(drop)
 }
 
-/// The module's two parts, whose texts follow each other: the plan (the
-/// header, the world and the steps' rows, most of a long plan's module),
-/// then the tree (the leaf classes, the trees, the steps' nodes). Neither
-/// needs the other, so two threads can make them at once.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Part {
-    Plan,
-    Tree,
-}
-
-/// [`emit_handing_over`] of one [`Part`] of the module.
+/// [`emit_handing_over`] of one of the module's two parts, whose texts
+/// follow each other: [`Part::First`] is the plan (the header, the world
+/// and the steps' rows, most of a long plan's module), [`Part::Second`]
+/// the tree (the leaf classes, the trees, the steps' nodes). Neither needs
+/// the other, so two threads can make them at once.
 pub fn emit_part_handing_over(
     ir: &TreeIr,
     options: &PyOptions<'_>,
     part: Part,
     hand: &mut Handover<'_>,
 ) -> std::io::Result<()> {
-    let models = models(ir);
+    // Only the tree needs the models (a walk of the main tree).
+    let models = match part {
+        Part::First => Vec::new(),
+        Part::Second => models(ir),
+    };
     let mut e = Emitter::new(ir, Sink::hand(hand));
     match part {
-        Part::Plan => e.plan_part(options),
-        Part::Tree => e.tree_part(&models, options),
+        Part::First => e.plan_part(options),
+        Part::Second => e.tree_part(&models, options),
     }
     e.sink.into_inner().finish(e.out).map(drop)
 }
